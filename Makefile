@@ -1,0 +1,27 @@
+# Two commands on a fresh machine:
+#   make demo   set up .venv (torch CPU wheel first) and run a teaching episode
+#   make test   set up .venv and run the test suite and the linter
+PYTHON ?= python3
+VENV ?= .venv
+PY := $(VENV)/bin/python
+STAMP := $(VENV)/.teachbot-installed
+
+.PHONY: demo test lint clean
+
+$(STAMP): pyproject.toml
+	test -x $(PY) || $(PYTHON) -m venv $(VENV)
+	$(PY) -m pip install --quiet torch==2.13.0
+	$(PY) -m pip install --quiet -e '.[dev]'
+	touch $(STAMP)
+
+demo: $(STAMP)
+	$(VENV)/bin/teachbot demo --seed 0 --turns 30 --budget 40 --change-every 5 --strategy active
+
+test: $(STAMP)
+	$(VENV)/bin/ruff check .
+	$(PY) -m pytest; status=$$?; \
+	if [ $$status -eq 5 ]; then echo "pytest collected no tests: that is a failure here"; exit 1; fi; \
+	exit $$status
+
+clean:
+	rm -rf $(VENV) runs .pytest_cache .ruff_cache

@@ -1,0 +1,1 @@
+"""The application: dialog manager, teachers, transcripts and the ``teachbot`` command."""

@@ -1,0 +1,65 @@
+"""The robot's candidate actions each turn and what they cost (thesis §7.3.1).
+
+Costs come from one table: demonstration query 2, feature-subset query 2,
+label query 1, no query 0 (configurable).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+DEFAULT_COSTS = {"label": 1, "demo": 2, "feature": 2, "none": 0}
+
+
+@dataclass(frozen=True)
+class LabelQuery:
+    """Point at scene object ``object_index`` and ask what it is (LQ)."""
+
+    object_index: int
+    kind: str = "label"
+
+
+@dataclass(frozen=True)
+class DemoQuery:
+    """Ask the teacher to show an example of ``concept`` (DQ)."""
+
+    concept: str
+    kind: str = "demo"
+
+
+@dataclass(frozen=True)
+class FeatureQuery:
+    """Ask which features tell the concepts apart (FSQ, asked at most once)."""
+
+    kind: str = "feature"
+
+
+@dataclass(frozen=True)
+class NoQuery:
+    """Stay quiet this turn."""
+
+    kind: str = "none"
+
+
+Action = LabelQuery | DemoQuery | FeatureQuery | NoQuery
+
+
+@dataclass(frozen=True)
+class Decision:
+    """A strategy's choice and its one-sentence reason."""
+
+    action: Action
+    explanation: str
+
+
+def validate_costs(costs: dict) -> dict[str, float]:
+    """Check a cost table: every action kind present, non-negative numbers."""
+    missing = sorted(set(DEFAULT_COSTS) - set(costs))
+    unknown = sorted(set(costs) - set(DEFAULT_COSTS))
+    if missing or unknown:
+        raise ValueError(f"cost table needs exactly the keys {sorted(DEFAULT_COSTS)}; "
+                         f"missing {missing}, unknown {unknown}")
+    for kind, value in costs.items():
+        if not isinstance(value, (int, float)) or isinstance(value, bool) or value < 0:
+            raise ValueError(f"cost of '{kind}' must be a non-negative number, got {value!r}")
+    return {kind: float(value) for kind, value in costs.items()}

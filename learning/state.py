@@ -1,0 +1,139 @@
+"""The learner's state: training set, feature subsets, current scene, budget and clock (thesis §7.3.1)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from learning.actions import DEFAULT_COSTS, Action, validate_costs
+from learning.concepts import ConceptModels, FeatureScaler
+
+
+@dataclass(frozen=True)
+class Example:
+    """One labelled instance and how it was obtained ("demo" or "label")."""
+
+    x: np.ndarray
+    concept: str
+    source: str
+    scene_id: int
+
+
+class LearningState:
+    """Everything a strategy may look at; the models are refit after every change."""
+
+    def __init__(self, concepts, feature_names, budget: float, turns: int, costs: dict | None = None,
+                 change_every: int = 1, variance: float = 4.0, length_scale: float | None = None):
+        if not concepts:
+            raise ValueError("at least one concept is needed")
+        if budget < 0 or turns < 1:
+            raise ValueError(f"budget must be >= 0 and turns >= 1, got budget {budget}, turns {turns}")
+        self.concepts = tuple(concepts)
+        self.feature_names = tuple(feature_names)
+        self.budget = float(budget)
+        self.turns = int(turns)
+        self.change_every = max(int(change_every), 1)
+        self.costs = validate_costs(costs or DEFAULT_COSTS)
+        self.examples: list[Example] = []
+        self.feature_subsets: dict[str, np.ndarray | None] = {c: None for c in self.concepts}
+        self.feature_query_asked = False
+        self.spent = 0.0
+        self.turn = 0
+        self.history: list[str] = []  # action kind of every finished turn
+        self.scene_X = np.zeros((0, len(self.feature_names)))
+        self.scene_id = -1
+        self.asked_in_scene: set[int] = set()
+        self.scaler = FeatureScaler(len(self.feature_names))
+        self.models = ConceptModels(self.concepts, variance=variance, length_scale=length_scale)
+        self._scene_P: np.ndarray | None = None
+        self.refit()
+
+    # -- the world ------------------------------------------------------------
+    def observe_scene(self, scene_id: int, X: np.ndarray) -> None:
+        """A new observation of the scene; a changed scene also widens the scaler's pool."""
+        X = np.asarray(X, dtype=float)
+        if X.ndim != 2 or X.shape[1] != len(self.feature_names):
+            raise ValueError(f"scene matrix must be (objects, {len(self.feature_names)}), got {X.shape}")
+        if scene_id != self.scene_id:
+            self.scene_id, self.scene_X = scene_id, X
+            self.asked_in_scene = set()
+            self.scaler.update(X)
+            self.refit()
+
+    # -- answers ----------------------------------------------------------------
+    def add_example(self, x: np.ndarray, concept: str, source: str) -> None:
+        if concept not in self.concepts:
+            raise ValueError(f"unknown concept '{concept}'; known: {', '.join(self.concepts)}")
+        self.examples.append(Example(np.asarray(x, dtype=float), concept, source, self.scene_id))
+        self.refit()
+
+    def remove_last_example(self) -> Example | None:
+        """Take back the most recent example (the teacher's "undo")."""
+        if not self.examples:
+            return None
+        example = self.examples.pop()
+        self.refit()
+        return example
+
+    def set_feature_subset(self, indices) -> None:
+        """Restrict every concept's classifier to the teacher's features from now on."""
+        indices = np.unique(np.asarray(indices, dtype=int))
+        if len(indices) == 0 or indices.min() < 0 or indices.max() >= len(self.feature_names):
+            raise ValueError(f"feature indices must be non-empty and within 0..{len(self.feature_names) - 1}")
+        self.feature_subsets = {c: indices for c in self.concepts}
+        self.refit()
+
+    def record_turn(self, action: Action) -> None:
+        """Charge the action's cost and advance the clock."""
+        cost = self.cost(action)
+        if cost > self.remaining_budget + 1e-9:
+            raise ValueError(f"{action.kind} query costs {cost} but only {self.remaining_budget} is left")
+        self.spent += cost
+        self.history.append(action.kind)
+        if action.kind == "feature":
+            self.feature_query_asked = True
+        if action.kind == "label":
+            self.asked_in_scene.add(action.object_index)
+        self.turn += 1
+
+    # -- budget -------------------------------------------------------------------
+    def cost(self, action: Action) -> float:
+        return self.costs[action.kind]
+
+    @property
+    def remaining_budget(self) -> float:
+        return self.budget - self.spent
+
+    def can_afford(self, action: Action) -> bool:
+        return self.cost(action) <= self.remaining_budget + 1e-9
+
+    # -- models -------------------------------------------------------------------
+    def training_matrix(self) -> tuple[np.ndarray, np.ndarray]:
+        if not self.examples:
+            return np.zeros((0, len(self.feature_names))), np.array([], dtype=object)
+        return np.vstack([e.x for e in self.examples]), np.array([e.concept for e in self.examples], dtype=object)
+
+    def refit(self) -> None:
+        X, labels = self.training_matrix()
+        self.models.fit(self.scaler.transform(X), labels, self.feature_subsets)
+        self._scene_P = None
+
+    def probabilities(self, X: np.ndarray | None = None) -> np.ndarray:
+        """(n, |Y|) p(y|x) for ``X`` (default: the current scene, cached)."""
+        if X is None:
+            if self._scene_P is None:
+                self._scene_P = self.models.predict(self.scaler.transform(self.scene_X))
+            return self._scene_P
+        return self.models.predict(self.scaler.transform(np.asarray(X, dtype=float)))
+
+    def counts_per_concept(self) -> dict[str, int]:
+        """Positive examples of each concept in the training set."""
+        counts = {c: 0 for c in self.concepts}
+        for example in self.examples:
+            counts[example.concept] += 1
+        return counts
+
+    def predict(self, X: np.ndarray) -> np.ndarray:
+        """The most probable concept name for each row."""
+        return np.array(self.concepts, dtype=object)[np.argmax(self.probabilities(X), axis=1)]

@@ -1,0 +1,46 @@
+"""A real episode in PyBullet through the command line."""
+
+import json
+
+import pytest
+
+from dialog.cli import main
+
+pytestmark = pytest.mark.e2e
+
+
+def run_demo(capsys, path, *extra):
+    code = main(["demo", "--turns", "8", "--budget", "10", "--change-every", "4", "--transcript", str(path),
+                 "--json", *extra])
+    assert code == 0
+    return json.loads(capsys.readouterr().out.strip().splitlines()[-1])
+
+
+def test_demo_runs_and_prints_a_json_summary(tmp_path, capsys):
+    summary = run_demo(capsys, tmp_path / "run.jsonl", "--seed", "2")
+    assert set(summary) == {"seed", "strategy", "turns", "budget_spent", "queries", "accuracy", "transcript",
+                            "seconds"}
+    assert summary["turns"] == 8 and summary["budget_spent"] <= 10
+    assert set(summary["queries"]) == {"label", "demo", "none"} and sum(summary["queries"].values()) == 8
+    lines = (tmp_path / "run.jsonl").read_text().splitlines()
+    assert len(lines) == 8
+    gestures = [json.loads(line)["gesture"] for line in lines if "gesture" in json.loads(line)]
+    assert gestures and all(g["reached"] and g["horizontal_error_m"] < 0.02 for g in gestures)
+
+
+def test_same_seed_twice_gives_byte_identical_transcripts(tmp_path, capsys):
+    run_demo(capsys, tmp_path / "a.jsonl", "--seed", "9", "--strategy", "passive")
+    run_demo(capsys, tmp_path / "b.jsonl", "--seed", "9", "--strategy", "passive")
+    run_demo(capsys, tmp_path / "c.jsonl", "--seed", "10", "--strategy", "passive")
+    first, second = (tmp_path / "a.jsonl").read_bytes(), (tmp_path / "b.jsonl").read_bytes()
+    assert first == second
+    assert first != (tmp_path / "c.jsonl").read_bytes()
+
+
+def test_bad_arguments_are_rejected_with_a_message(capsys):
+    with pytest.raises(SystemExit):
+        main(["demo", "--strategy", "clever"])
+    assert "invalid choice: 'clever'" in capsys.readouterr().err
+    with pytest.raises(SystemExit):
+        main(["demo", "--turns", "0"])
+    assert "at least 1" in capsys.readouterr().err

@@ -1,0 +1,46 @@
+"""The binary GP classifier on small arrays."""
+
+import numpy as np
+import pytest
+from sklearn.gaussian_process import GaussianProcessClassifier
+from sklearn.gaussian_process.kernels import RBF, ConstantKernel
+
+from learning.gp import BinaryGPClassifier
+
+
+def separable(rng, n=80, d=3):
+    X = rng.normal(size=(n, d))
+    return X, (X[:, 0] + 0.5 * X[:, 1] > 0).astype(int)
+
+
+def test_learns_a_separable_concept(rng):
+    X, y = separable(rng)
+    X_test, y_test = separable(rng, 200)
+    model = BinaryGPClassifier(length_scale=1.5).fit(X, y)
+    assert np.mean((model.predict_proba(X_test) > 0.5) == y_test) > 0.85
+
+
+def test_agrees_with_scikit_learn_laplace_gpc(rng):
+    X, y = separable(rng)
+    X_test = rng.normal(size=(30, 3))
+    ours = BinaryGPClassifier(length_scale=1.5, variance=4.0).fit(X, y).predict_proba(X_test)
+    kernel = ConstantKernel(4.0, "fixed") * RBF(1.5, "fixed")
+    theirs = GaussianProcessClassifier(kernel=kernel, optimizer=None).fit(X, y).predict_proba(X_test)[:, 1]
+    assert np.max(np.abs(ours - theirs)) < 0.03
+
+
+def test_no_data_gives_the_prior(rng):
+    model = BinaryGPClassifier().fit(np.zeros((0, 4)), np.zeros(0))
+    assert np.allclose(model.predict_proba(rng.normal(size=(5, 4))), 0.5)
+
+
+def test_one_example_leans_positive_near_it_and_prior_far_away():
+    model = BinaryGPClassifier(length_scale=1.0).fit(np.zeros((1, 2)), [1])
+    near, far = model.predict_proba(np.array([[0.0, 0.0], [10.0, 10.0]]))
+    assert near > 0.6
+    assert far == pytest.approx(0.5, abs=1e-6)
+
+
+def test_shape_mismatch_is_a_clear_error():
+    with pytest.raises(ValueError, match="one row per label"):
+        BinaryGPClassifier().fit(np.zeros((3, 2)), [1, 0])

@@ -1,0 +1,98 @@
+"""Learning state bookkeeping and the two baseline strategies."""
+
+import numpy as np
+import pytest
+
+from learning.actions import DemoQuery, LabelQuery, NoQuery, validate_costs
+from learning.concepts import entropy
+from learning.evaluation import accuracy
+from learning.state import LearningState
+from learning.strategies import make_strategy
+
+CONCEPTS = ("a", "b", "c")
+
+
+def blobs(rng, per_class=6):
+    centres = np.array([[0, 0, 0], [4, 0, 0], [0, 4, 0]], dtype=float)
+    X = np.vstack([c + rng.normal(0, 0.5, (per_class, 3)) for c in centres])
+    return X, np.repeat(CONCEPTS, per_class)
+
+
+def state_with_scene(rng, budget=10, turns=10):
+    state = LearningState(CONCEPTS, ["f1", "f2", "f3"], budget=budget, turns=turns)
+    X, labels = blobs(rng)
+    state.observe_scene(0, X)
+    return state, X, labels
+
+
+def test_labelled_examples_make_the_models_accurate(rng):
+    state, X, labels = state_with_scene(rng)
+    for index in range(0, len(X), 2):
+        state.add_example(X[index], labels[index], "label")
+    X_test, y_test = blobs(rng, 20)
+    assert accuracy(state.predict(X_test), y_test) > 0.9
+
+
+def test_budget_is_charged_and_never_exceeded(rng):
+    state, _, _ = state_with_scene(rng, budget=3)
+    state.record_turn(DemoQuery("a"))
+    assert state.remaining_budget == 1 and state.can_afford(LabelQuery(0))
+    assert not state.can_afford(DemoQuery("b"))
+    with pytest.raises(ValueError, match="costs 2"):
+        state.record_turn(DemoQuery("b"))
+    state.record_turn(NoQuery())
+    assert state.spent == 2 and state.history == ["demo", "none"]
+
+
+def test_passive_asks_for_the_least_represented_concept(rng):
+    state, X, labels = state_with_scene(rng)
+    state.add_example(X[0], "a", "demo")
+    state.add_example(X[7], "b", "demo")
+    decision = make_strategy("passive").choose(state, rng)
+    assert decision.action == DemoQuery("c")
+
+
+def test_active_asks_about_the_most_uncertain_object(rng):
+    state, X, labels = state_with_scene(rng)
+    state.add_example(X[0], "a", "label")
+    state.add_example(X[6], "b", "label")
+    decision = make_strategy("active").choose(state, rng)
+    scores = entropy(state.probabilities())
+    assert decision.action == LabelQuery(int(np.argmax(scores)))
+    assert "can't tell" in decision.explanation
+
+
+def test_active_does_not_repeat_an_object_in_the_same_scene(rng):
+    state, X, _ = state_with_scene(rng, budget=100, turns=100)
+    strategy, asked = make_strategy("active"), set()
+    for _ in range(len(X)):
+        action = strategy.choose(state, rng).action
+        assert action.object_index not in asked
+        asked.add(action.object_index)
+        state.record_turn(action)
+    assert strategy.choose(state, rng).action == NoQuery()
+
+
+def test_strategies_stay_quiet_without_budget(rng):
+    state, _, _ = state_with_scene(rng, budget=0)
+    for name in ("passive", "active"):
+        decision = make_strategy(name).choose(state, rng)
+        assert decision.action == NoQuery() and "budget" in decision.explanation
+
+
+def test_unknown_strategy_and_bad_costs_are_clear_errors():
+    with pytest.raises(ValueError, match="choose one of: passive, active"):
+        make_strategy("clever")
+    with pytest.raises(ValueError, match="missing"):
+        validate_costs({"label": 1})
+    with pytest.raises(ValueError, match="non-negative"):
+        validate_costs({"label": -1, "demo": 2, "feature": 2, "none": 0})
+
+
+def test_undo_removes_the_last_example(rng):
+    state, X, _ = state_with_scene(rng)
+    state.add_example(X[0], "a", "label")
+    before = state.probabilities().copy()
+    state.add_example(X[1], "b", "label")
+    assert state.remove_last_example().concept == "b"
+    assert np.allclose(state.probabilities(), before)
