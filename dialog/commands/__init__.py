@@ -1,0 +1,1 @@
+"""One module per ``teachbot`` subcommand (see ``dialog/cli.py``)."""
