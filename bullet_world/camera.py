@@ -5,8 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-
-from bullet_world.pybullet_import import pybullet as p
+import pybullet as p
 
 
 @dataclass

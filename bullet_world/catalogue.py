@@ -174,7 +174,33 @@ class Kitchen:
     min_gap: float
     camera: dict
     lighting: dict
-    interest_points: dict[str, tuple[float, float, float]]
+    locations: dict[str, Location]
+
+    @property
+    def interest_points(self) -> dict[str, tuple[float, float, float]]:
+        """The centre of every semantic location."""
+        return {name: location.centre for name, location in self.locations.items()}
+
+
+@dataclass(frozen=True)
+class Location:
+    """A semantic location ("stove"): a centre on the counter and the half size of its region."""
+
+    name: str
+    centre: tuple[float, float, float]
+    half_size: tuple[float, float]
+
+    def contains(self, xy) -> bool:
+        return all(abs(float(xy[i]) - self.centre[i]) <= self.half_size[i] for i in range(2))
+
+
+def _location(name: str, table, where: str) -> Location:
+    if not isinstance(table, dict):
+        raise DataFileError(f"{where}: must be a table with 'centre' = [x, y, z] and 'half_size' = [hx, hy]")
+    half = _field(table, "half_size", where, length=2)
+    if min(half) <= 0:
+        raise DataFileError(f"{where}: 'half_size' must be positive, got {half}")
+    return Location(name, tuple(_field(table, "centre", where, length=3)), tuple(half))
 
 
 def load_kitchen(name_or_path: str | Path) -> Kitchen:
@@ -183,7 +209,7 @@ def load_kitchen(name_or_path: str | Path) -> Kitchen:
     table = _read_toml(path)
     where = str(path)
     section = {key: _field(table, key, where, dict) for key in
-               ("counter", "robot", "object_region", "camera", "lighting", "interest_points")}
+               ("counter", "robot", "object_region", "camera", "lighting", "locations")}
     cam = section["camera"]
     camera = {key: _field(cam, key, f"{where} [camera]", length=3) for key in ("eye", "target", "up")}
     for key in ("fov_degrees", "near", "far"):
@@ -210,8 +236,6 @@ def load_kitchen(name_or_path: str | Path) -> Kitchen:
         min_gap=float(_field(region, "min_gap", f"{where} [object_region]")),
         camera=camera,
         lighting=lighting,
-        interest_points={
-            name: tuple(_field(section["interest_points"], name, f"{where} [interest_points]", length=3))
-            for name in section["interest_points"]
-        },
+        locations={name: _location(name, table, f"{where} [locations.{name}]")
+                   for name, table in section["locations"].items()},
     )

@@ -5,12 +5,12 @@ from __future__ import annotations
 from typing import Protocol
 
 import numpy as np
+import pybullet as p
 
 from bullet_world.camera import Camera, Lighting
 from bullet_world.catalogue import Kitchen, ObjectKind, Task, load_kitchen, load_task
 from bullet_world.features import feature_row, object_feature_catalogue, object_feature_values
 from bullet_world.perception import measure_objects
-from bullet_world.pybullet_import import pybullet as p
 from bullet_world.scene import Scene, SceneTruth
 
 WEIGHT_NOISE_KG = 0.005  # standard deviation of the scale under the counter

@@ -10,9 +10,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import pybullet as p
 import pybullet_data
-
-from bullet_world.pybullet_import import pybullet as p
 
 ARM_JOINTS = tuple(range(7))
 FINGER_JOINTS = (9, 10)

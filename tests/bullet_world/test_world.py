@@ -63,3 +63,14 @@ def test_broken_object_file_names_the_field(tmp_path):
     path.write_text("this is = = not toml")
     with pytest.raises(DataFileError, match="not valid TOML"):
         load_object_kinds(path)
+
+
+def test_kitchen_locations_are_regions_within_reach():
+    kitchen = load_kitchen("kitchen-1")
+    assert {"stove", "fridge", "cupboard", "pantry", "counter"} <= set(kitchen.locations)
+    base = np.asarray(kitchen.robot_base[:2])
+    for location in kitchen.locations.values():
+        assert location.contains(location.centre[:2])
+        corner = np.asarray(location.centre[:2]) + np.asarray(location.half_size)
+        assert not location.contains(corner + 0.01)
+        assert np.linalg.norm(np.asarray(location.centre[:2]) - base) < 0.8
