@@ -22,11 +22,12 @@ class FeatureInfo:
     name: str
     group: str
     description: str
+    source: str = "object"  # "object": measured per object; "robot": from the attached robot
 
 
 @lru_cache(maxsize=1)
-def object_feature_catalogue() -> tuple[FeatureInfo, ...]:
-    """The object features of ``data/features.toml``, in column order."""
+def feature_catalogue() -> tuple[FeatureInfo, ...]:
+    """Every feature of ``data/features.toml``, in column order."""
     path = DATA_DIR / "features.toml"
     with open(path, "rb") as handle:
         entries = tomllib.load(handle).get("feature", [])
@@ -35,11 +36,33 @@ def object_feature_catalogue() -> tuple[FeatureInfo, ...]:
         missing = [key for key in ("name", "group", "description") if not entry.get(key)]
         if missing:
             raise DataFileError(f"{path}: feature {index + 1} lacks {', '.join(missing)}")
-        infos.append(FeatureInfo(entry["name"], entry["group"], entry["description"]))
+        source = entry.get("source", "object")
+        if source not in ("object", "robot"):
+            raise DataFileError(f"{path}: feature '{entry['name']}' has source '{source}'; use object or robot")
+        infos.append(FeatureInfo(entry["name"], entry["group"], entry["description"], source))
     names = [info.name for info in infos]
     if len(set(names)) != len(names):
         raise DataFileError(f"{path}: feature names must be unique")
     return tuple(infos)
+
+
+def object_feature_catalogue() -> tuple[FeatureInfo, ...]:
+    """The features measured per object, in column order."""
+    return tuple(info for info in feature_catalogue() if info.source == "object")
+
+
+def robot_feature_catalogue() -> tuple[FeatureInfo, ...]:
+    """The features an attached robot reports, in column order."""
+    return tuple(info for info in feature_catalogue() if info.source == "robot")
+
+
+def feature_info(names) -> list[FeatureInfo]:
+    """Name, group and description of each named feature (for the feature-subset question)."""
+    by_name = {info.name: info for info in feature_catalogue()}
+    unknown = [name for name in names if name not in by_name]
+    if unknown:
+        raise KeyError(f"features not in the catalogue: {unknown}")
+    return [by_name[name] for name in names]
 
 
 def object_feature_values(measurement: ObjectMeasurement, weight_reading: float) -> dict[str, float]:

@@ -9,7 +9,12 @@ import pybullet as p
 
 from bullet_world.camera import Camera, Lighting
 from bullet_world.catalogue import Kitchen, ObjectKind, Task, load_kitchen, load_task
-from bullet_world.features import feature_row, object_feature_catalogue, object_feature_values
+from bullet_world.features import (
+    feature_row,
+    object_feature_catalogue,
+    object_feature_values,
+    robot_feature_catalogue,
+)
 from bullet_world.perception import measure_objects
 from bullet_world.scene import Scene, SceneTruth
 
@@ -20,8 +25,6 @@ class Proprioceptor(Protocol):
     """What the world needs from an attached robot (robot.Arm satisfies it)."""
 
     body_id: int
-
-    def feature_names(self) -> tuple[str, ...]: ...
 
     def proprioception(self) -> dict[str, float]: ...
 
@@ -73,8 +76,8 @@ class World:
 
     @property
     def feature_names(self) -> tuple[str, ...]:
-        names = tuple(info.name for info in object_feature_catalogue())
-        return names + (self.robot.feature_names() if self.robot else ())
+        catalogue = object_feature_catalogue() + (robot_feature_catalogue() if self.robot else ())
+        return tuple(info.name for info in catalogue)
 
     def close(self) -> None:
         if p.isConnected(self.client):
@@ -135,6 +138,33 @@ class World:
         orientation = p.getQuaternionFromEuler([0, 0, yaw])
         return p.createMultiBody(draw["mass"], collision, visual, position, orientation, physicsClientId=self.client)
 
+    @property
+    def object_bodies(self) -> tuple[int, ...]:
+        """PyBullet body ids of the scene objects, in object-number order."""
+        return tuple(self._bodies)
+
+    def add_object(self, kind: ObjectKind, xy, yaw: float, rng: np.random.Generator | None = None,
+                   draw: dict | None = None) -> int:
+        """Spawn one object of ``kind`` standing at ``xy``; its size, colour and mass come from
+        ``draw`` or are drawn with ``rng``. Returns the body id; it joins the next observation."""
+        if draw is None:
+            if rng is None:
+                raise ValueError("add_object needs either a generator or a draw")
+            draw = kind.sample(rng)
+        body = self._spawn(kind, draw, np.asarray(xy, dtype=float), yaw)
+        dims = draw["dimensions"]
+        size = [dims["length"], dims["width"]] if kind.shape == "box" else [2 * dims["radius"]] * 2
+        self._bodies.append(body)
+        self._truth_rows.append({"kind": kind.name, "concept": kind.concept, "mass": draw["mass"],
+                                 "size": [*size, object_height(kind, dims)]})
+        return body
+
+    def remove_object(self, body: int) -> None:
+        """Take one object out of the world and out of later observations."""
+        index = self._bodies.index(body)
+        p.removeBody(body, physicsClientId=self.client)
+        del self._bodies[index], self._truth_rows[index]
+
     def _draw_kinds(self, rng: np.random.Generator) -> list[ObjectKind]:
         """Stratified draw: concepts as evenly represented as the object count allows."""
         concepts = list(self.task.concepts)
@@ -153,12 +183,7 @@ class World:
         draws = [kind.sample(rng) for kind in kinds]
         centres = self._place([footprint_radius(k, d["dimensions"]) for k, d in zip(kinds, draws)], rng)
         for kind, draw, xy in zip(kinds, draws, centres):
-            body = self._spawn(kind, draw, xy, float(rng.uniform(0, np.pi)))
-            self._bodies.append(body)
-            dims = draw["dimensions"]
-            size = ([dims["length"], dims["width"]] if kind.shape == "box" else [2 * dims["radius"]] * 2)
-            self._truth_rows.append({"kind": kind.name, "concept": kind.concept, "mass": draw["mass"],
-                                     "size": [*size, object_height(kind, dims)]})
+            self.add_object(kind, xy, float(rng.uniform(0, np.pi)), draw=draw)
         self.lighting = Lighting.sample(self.kitchen.lighting, rng)
         self._scene_count += 1
         return self.observe()
@@ -187,9 +212,10 @@ class World:
             concepts=tuple(t["concept"] for t in self._truth_rows),
             kinds=tuple(t["kind"] for t in self._truth_rows),
             body_ids=tuple(self._bodies),
-            positions=true_positions,
+            positions=true_positions.reshape(-1, 3),
             sizes=np.array([t["size"] for t in self._truth_rows]),
         )
-        self.scene = Scene(self._scene_count, np.vstack(rows), names, np.array(positions), np.array(tops),
-                           np.array(colours), truth)
+        X = np.vstack(rows) if rows else np.zeros((0, len(names)))
+        self.scene = Scene(self._scene_count, X, names, np.array(positions).reshape(-1, 3), np.array(tops),
+                           np.array(colours).reshape(-1, 3), truth)
         return self.scene

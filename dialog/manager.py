@@ -74,9 +74,11 @@ class DialogManager:
     """Runs one episode of the loop with any environment, teacher and strategy."""
 
     def __init__(self, environment: Environment, teacher: Teacher, strategy: Strategy, config: EpisodeConfig,
-                 transcript: TranscriptWriter, rngs: dict[str, np.random.Generator], say=print):
+                 transcript: TranscriptWriter, rngs: dict[str, np.random.Generator], say=print,
+                 observers: tuple = ()):
         self.env, self.teacher, self.strategy = environment, teacher, strategy
         self.config, self.transcript, self.rngs, self.say = config, transcript, rngs, say
+        self.observers = tuple(observers)
         self.state = LearningState(environment.concepts, environment.feature_names, config.budget, config.turns,
                                    costs=config.costs, change_every=config.change_every)
 
@@ -88,10 +90,12 @@ class DialogManager:
             if turn % self.config.change_every == 0:
                 scene = self.env.next_scene(self.rngs["scenes"])
                 self.state.observe_scene(scene.scene_id, scene.X)
+                self._notify("on_scene", scene)
                 self.say(f"-- turn {turn + 1}: the robot looks at a new scene of {scene.n_objects} objects")
             record = self._turn(turn, scene)
             record["accuracy"] = round(accuracy(self.state.predict(test_X), test_y), 6)
             self.transcript.write(record)
+            self._notify("on_turn", record, scene)
         final = accuracy(self.state.predict(test_X), test_y)
         kinds = Counter(self.state.history)
         return EpisodeResult(
@@ -129,6 +133,13 @@ class DialogManager:
             "model": {"examples": self.state.counts_per_concept()},
         })
         return record
+
+    def _notify(self, event: str, *payload) -> None:
+        """Tell observers (a viewer, a progress display) what happened; they may not change the episode."""
+        for observer in self.observers:
+            handler = getattr(observer, event, None)
+            if handler is not None:
+                handler(*payload)
 
     def _apply(self, action: Action, answer: Answer, scene) -> None:
         if answer.value is None:

@@ -85,11 +85,11 @@ class Arm:
                                     physicsClientId=self.client)
 
     # -- proprioception ------------------------------------------------------
-    def feature_names(self) -> tuple[str, ...]:
-        return tuple(f"arm.joint{j + 1}" for j in ARM_JOINTS) + ("hand.x", "hand.y", "hand.z", "hand.opening")
-
     def proprioception(self) -> dict[str, float]:
-        """Joint angles, the hand's position relative to the base, and the gripper opening."""
+        """Joint angles, the hand's position relative to the base, and the gripper opening.
+
+        The keys are the ``source = "robot"`` features of ``bullet_world/data/features.toml``.
+        """
         joints = self.joint_positions()
         hand = self.fingertip_position() - self.base_position
         values = {f"arm.joint{j + 1}": float(q) for j, q in enumerate(joints)}

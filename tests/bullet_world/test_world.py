@@ -74,3 +74,23 @@ def test_kitchen_locations_are_regions_within_reach():
         corner = np.asarray(location.centre[:2]) + np.asarray(location.half_size)
         assert not location.contains(corner + 0.01)
         assert np.linalg.norm(np.asarray(location.centre[:2]) - base) < 0.8
+
+
+def test_every_feature_has_a_name_group_and_description(kitchen):
+    from bullet_world.features import feature_info
+
+    infos = feature_info(kitchen.feature_names)
+    assert [info.name for info in infos] == list(kitchen.feature_names)
+    for info in infos:
+        assert info.group.count("/") >= 1 and len(info.description) > 15
+
+
+def test_objects_can_be_added_and_removed_by_hand():
+    with World(seed=2) as world:
+        kind = next(k for k in world.task.kinds if k.name == "apple")
+        body = world.add_object(kind, (0.1, 0.0), 0.0, rng=np.random.default_rng(0))
+        scene = world.observe()
+        assert scene.truth.kinds == ("apple",) and world.object_bodies == (body,)
+        assert np.allclose(scene.positions[0, :2], (0.1, 0.0), atol=0.005)
+        world.remove_object(body)
+        assert world.object_bodies == () and world.observe().X.shape == (0, len(world.feature_names))

@@ -81,3 +81,24 @@ def test_same_seed_gives_identical_transcripts(tmp_path):
     run_episode(tmp_path / "a", turns=10, budget=10, seed=4)
     run_episode(tmp_path / "b", turns=10, budget=10, seed=4)
     assert (tmp_path / "a" / "t.jsonl").read_bytes() == (tmp_path / "b" / "t.jsonl").read_bytes()
+
+
+def test_observers_see_every_scene_and_turn(tmp_path):
+    class Recorder:
+        def __init__(self):
+            self.scenes, self.turns = [], []
+
+        def on_scene(self, scene):
+            self.scenes.append(scene.scene_id)
+
+        def on_turn(self, record, scene):
+            self.turns.append((record["turn"], scene.scene_id))
+
+    recorder = Recorder()
+    config = EpisodeConfig(turns=6, budget=6, change_every=3)
+    rngs = episode_generators(0)
+    with TranscriptWriter(tmp_path / "t.jsonl") as transcript:
+        DialogManager(FakeEnvironment(), OracleTeacher(rngs["teacher"]), make_strategy("active"), config,
+                      transcript, rngs, say=lambda _: None, observers=[recorder]).run()
+    assert len(recorder.scenes) == 2 and [t for t, _ in recorder.turns] == [1, 2, 3, 4, 5, 6]
+    assert recorder.turns[3][1] == recorder.scenes[1]
