@@ -1,0 +1,1 @@
+"""Scripted-teacher regression runs: suites of episodes, reports, baselines (``teachbot regress``)."""

@@ -1,0 +1,99 @@
+"""Regression suites: loading, checkpoint analysis, findings, baselines, and one tiny real run."""
+
+import json
+
+import numpy as np
+import pytest
+
+from dialog.cli import main
+from dialog.regress.analysis import checkpoint_values, summarise, evaluate_findings
+from dialog.regress.baseline import check_against_baseline, write_baseline
+from dialog.regress.suite import SuiteError, load_suite
+
+SUITE = """
+name = "tiny"
+description = "test suite"
+strategies = ["passive", "active"]
+datasets = 2
+checkpoints = [1, 2, 3]
+[options]
+pool_scenes = 2
+[costs]
+label = 1
+demo = 1
+feature = 1
+none = 0
+[[condition]]
+name = "static"
+budget = 3
+turns = 4
+change_every = 2
+[[finding]]
+id = "f1"
+text = "passive beats active"
+condition = "static"
+at = 3
+better = "passive"
+than = ["active"]
+"""
+
+
+def write_suite(tmp_path, text=SUITE):
+    path = tmp_path / "tiny.toml"
+    path.write_text(text)
+    return path
+
+
+def fake_result(strategy, accuracies, questions, dataset=0):
+    n = len(accuracies)
+    return {"spec": {"condition": {"name": "static"}, "strategy": strategy, "dataset": dataset, "seed": 0},
+            "series": {"turn": list(range(1, n + 1)), "accuracy": accuracies, "questions": questions,
+                       "label": questions, "demo": [0] * n, "feature": [0] * n, "spent": questions},
+            "accuracy": accuracies[-1], "seconds": 0.1}
+
+
+def test_suite_errors_name_the_problem(tmp_path):
+    with pytest.raises(SuiteError, match="unknown suite 'nope'; available: .*smoke"):
+        load_suite("nope")
+    with pytest.raises(SuiteError, match="unknown strategies \\['clever'\\]"):
+        load_suite(write_suite(tmp_path, SUITE.replace('"active"]', '"clever"]')), ["passive", "active"])
+    with pytest.raises(SuiteError, match="missing 'budget'"):
+        load_suite(write_suite(tmp_path, SUITE.replace("budget = 3\n", "")))
+    with pytest.raises(SuiteError, match="not in the suite's strategies"):
+        load_suite(write_suite(tmp_path, SUITE.replace('than = ["active"]', 'than = ["random"]')))
+
+
+def test_checkpoints_use_the_first_turn_with_enough_questions_else_the_final_accuracy(tmp_path):
+    suite = load_suite(write_suite(tmp_path))
+    result = fake_result("active", [0.3, 0.5, 0.6, 0.7], [1, 1, 2, 2])
+    assert checkpoint_values(result, suite) == pytest.approx([0.3, 0.6, 0.7])
+
+
+def test_findings_and_baseline_bands(tmp_path):
+    suite = load_suite(write_suite(tmp_path))
+    results = [fake_result("passive", [0.5, 0.7, 0.8, 0.9], [1, 2, 3, 3], d) for d in range(5)]
+    results += [fake_result("active", [0.3, 0.4, 0.45, 0.5], [1, 2, 3, 3], d) for d in range(5)]
+    summaries = summarise(results, suite)
+    (finding,) = evaluate_findings(summaries, suite)
+    assert finding.holds and finding.comparisons[0].p < 0.01
+    path = write_baseline(suite, summaries, tmp_path / "base.json")
+    assert check_against_baseline(suite, summaries, path) == []
+    worse = summarise([fake_result("passive", [0.5, 0.5, 0.5, 0.5], [1, 2, 3, 3])] + results[5:], suite)
+    failures = check_against_baseline(suite, worse, path)
+    assert failures and "passive/static after 2 questions: accuracy 0.500 is below its band" in failures[0]
+    assert "no stored baseline" in check_against_baseline(suite, summaries, tmp_path / "missing.json")[0]
+
+
+def test_a_tiny_suite_runs_end_to_end(tmp_path, capsys):
+    code = main(["regress", "--suite", str(write_suite(tmp_path)), "--results", str(tmp_path / "out"),
+                 "--workers", "1", "--no-progress", "--json"])
+    assert code == 0
+    summary = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
+    assert summary["suite"] == "tiny" and summary["episodes"] == 4 and summary["passed"]
+    report = (tmp_path / "out" / "report.md").read_text()
+    assert "f1: passive beats active" in report and "curves-static.png" in report
+    assert (tmp_path / "out" / "curves-static.png").stat().st_size > 1000
+    rows = (tmp_path / "out" / "episodes.csv").read_text().splitlines()
+    assert len(rows) == 5 and rows[0].startswith("condition,strategy")
+    first = np.loadtxt(tmp_path / "out" / "episodes" / "static" / "passive-d0-s0.csv", delimiter=",", skiprows=1)
+    assert first.shape == (4, 7) and first[-1, 6] <= 3
