@@ -8,7 +8,7 @@ import time
 from pathlib import Path
 
 from dialog.commands._arguments import budget, positive_int
-from dialog.regress.analysis import summarise, evaluate_findings
+from dialog.regress.analysis import evaluate_findings, summarise
 from dialog.regress.baseline import check_against_baseline, write_baseline
 from dialog.regress.report import markdown_report, plot_learning_curves, plot_question_timing, write_episode_csvs
 from dialog.regress.runner import episode_specs, run_locally, run_on_ray

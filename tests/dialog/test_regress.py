@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from dialog.cli import main
-from dialog.regress.analysis import checkpoint_values, summarise, evaluate_findings
+from dialog.regress.analysis import checkpoint_values, evaluate_findings, summarise
 from dialog.regress.baseline import check_against_baseline, write_baseline
 from dialog.regress.suite import SuiteError, load_suite
 
@@ -97,3 +97,22 @@ def test_a_tiny_suite_runs_end_to_end(tmp_path, capsys):
     assert len(rows) == 5 and rows[0].startswith("condition,strategy")
     first = np.loadtxt(tmp_path / "out" / "episodes" / "static" / "passive-d0-s0.csv", delimiter=",", skiprows=1)
     assert first.shape == (4, 7) and first[-1, 6] <= 3
+
+
+def test_the_same_suite_runs_on_a_local_ray_instance(tmp_path, capsys):
+    ray = pytest.importorskip("ray", reason="the optional Ray extra is not installed")
+    try:
+        code = main(["regress", "--suite", str(write_suite(tmp_path)), "--results", str(tmp_path / "ray"),
+                     "--ray", "local", "--no-progress", "--json"])
+    finally:
+        ray.shutdown()
+    assert code == 0
+    local = main(["regress", "--suite", str(write_suite(tmp_path)), "--results", str(tmp_path / "local"),
+                  "--workers", "1", "--no-progress", "--json"])
+    assert local == 0
+    on_ray = (tmp_path / "ray" / "episodes.csv").read_text().splitlines()
+    here = (tmp_path / "local" / "episodes.csv").read_text().splitlines()
+    def without_timing(rows):
+        return [",".join(row.split(",")[:10]) for row in rows]
+
+    assert without_timing(on_ray) == without_timing(here)
