@@ -10,6 +10,8 @@ from pathlib import Path
 from dialog.commands._arguments import budget, positive_int
 from dialog.regress.analysis import evaluate_findings, summarise
 from dialog.regress.baseline import check_against_baseline, write_baseline
+from dialog.regress.episodes import load_pools
+from dialog.regress.feature_report import feature_summaries, run_feature_suite, write_feature_report
 from dialog.regress.report import markdown_report, plot_learning_curves, plot_question_timing, write_episode_csvs
 from dialog.regress.runner import episode_specs, run_locally, run_on_ray
 from dialog.regress.suite import load_suite, suite_names
@@ -37,28 +39,37 @@ def register(commands) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    if args.strategies:
-        unknown = [s for s in args.strategies if s not in STRATEGY_NAMES]
-        if unknown:
-            raise ValueError(f"unknown strategies {unknown}; choose from: {', '.join(STRATEGY_NAMES)}")
     suite = load_suite(args.suite, known_strategies=STRATEGY_NAMES).with_overrides(
         strategies=args.strategies, seeds=args.seeds, budget=args.budget, datasets=args.datasets)
-    if suite.kind != "episodes":
-        raise ValueError(f"suite '{suite.name}' is of kind '{suite.kind}', which this version cannot run yet")
+    if suite.kind == "episodes":
+        unknown = [s for s in suite.strategies if s not in STRATEGY_NAMES]
+        if unknown:
+            raise ValueError(f"unknown strategies {unknown}; choose from: {', '.join(STRATEGY_NAMES)}")
     out = args.results or Path("results") / suite.name
     out.mkdir(parents=True, exist_ok=True)
     pool_scenes = args.pool_scenes or int(suite.options.get("pool_scenes", 30))
-    specs = episode_specs(suite, out, pool_scenes)
     started = time.perf_counter()
-    progress = not args.no_progress
-    results = run_on_ray(specs, args.ray, progress) if args.ray else run_locally(specs, args.workers, progress)
-    seconds = time.perf_counter() - started
-    summaries = summarise(results, suite)
-    findings = evaluate_findings(summaries, suite)
-    write_episode_csvs(results, out)
-    figures = plot_learning_curves(results, suite, out) + plot_question_timing(results, suite, out)
-    report = markdown_report(suite, results, summaries, findings, seconds, out, figures)
-    print(f"{suite.name}: {len(results)} episodes in {seconds:.1f} s; report {report}")
+    if suite.kind == "feature-selection":
+        rows = run_feature_suite(suite, load_pools(suite.task, suite.kitchen, 1, pool_scenes))
+        seconds = time.perf_counter() - started
+        summaries = feature_summaries(rows, suite)
+        findings = evaluate_findings(summaries, suite)
+        report = write_feature_report(suite, rows, summaries, findings, seconds, out)
+        count = len(rows)
+    elif suite.kind == "episodes":
+        specs = episode_specs(suite, out, pool_scenes)
+        progress = not args.no_progress
+        results = run_on_ray(specs, args.ray, progress) if args.ray else run_locally(specs, args.workers, progress)
+        seconds = time.perf_counter() - started
+        summaries = summarise(results, suite)
+        findings = evaluate_findings(summaries, suite)
+        write_episode_csvs(results, out)
+        figures = plot_learning_curves(results, suite, out) + plot_question_timing(results, suite, out)
+        report = markdown_report(suite, results, summaries, findings, seconds, out, figures)
+        count = len(results)
+    else:
+        raise ValueError(f"suite '{suite.name}' is of kind '{suite.kind}', which this version cannot run yet")
+    print(f"{suite.name}: {count} runs in {seconds:.1f} s; report {report}")
     for outcome in findings:
         ps = ", ".join(f"{c.b} p={c.p:.3g}" for c in outcome.comparisons)
         print(f"  {outcome.finding.id}: {'holds' if outcome.holds else 'does not hold'} ({ps})")
@@ -68,6 +79,6 @@ def run(args: argparse.Namespace) -> int:
     for failure in failures:
         print(f"  REGRESSION {failure}")
     if args.json:
-        print(json.dumps({"suite": suite.name, "episodes": len(results), "seconds": round(seconds, 2),
+        print(json.dumps({"suite": suite.name, "episodes": count, "seconds": round(seconds, 2),
                           "passed": not failures, "failures": failures}))
     return 1 if failures else 0

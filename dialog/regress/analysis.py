@@ -70,11 +70,12 @@ def evaluate_findings(summaries: list[CheckpointSummary], suite: Suite) -> list[
     lookup = {(s.condition, s.strategy): s for s in summaries}
     outcomes = []
     for finding in suite.findings:
-        column = suite.checkpoints.index(finding.at) if finding.at in suite.checkpoints else None
-        if column is None:
+        if finding.at not in suite.checkpoints:
             raise ValueError(f"finding '{finding.id}' is checked at {finding.at}, which is not a checkpoint "
                              f"of suite '{suite.name}' {list(suite.checkpoints)}")
-        better = lookup[(finding.condition, finding.better)].values[:, column]
+        better_summary = lookup[(finding.condition, finding.better)]
+        column = better_summary.checkpoints.index(finding.at)
+        better = better_summary.values[:, column]
         comparisons = []
         for other in finding.than:
             values = lookup[(finding.condition, other)].values[:, column]

@@ -132,7 +132,8 @@ def load_suite(name_or_path: str | Path, known_strategies=None) -> Suite:
     findings = []
     for i, f in enumerate(table.get("finding", [])):
         at = f"{where} finding {i + 1}"
-        finding = Finding(_need(f, "id", str, at), _need(f, "text", str, at), f.get("condition", ""),
+        default_condition = f"n{f.get('at')}" if kind == "feature-selection" else ""
+        finding = Finding(_need(f, "id", str, at), _need(f, "text", str, at), f.get("condition", default_condition),
                           _need(f, "at", int, at), _need(f, "better", str, at), tuple(_need(f, "than", list, at)),
                           f.get("alternative", "greater"))
         missing = [s for s in (finding.better, *finding.than) if s not in strategies]

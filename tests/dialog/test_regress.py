@@ -116,3 +116,30 @@ def test_the_same_suite_runs_on_a_local_ray_instance(tmp_path, capsys):
         return [",".join(row.split(",")[:10]) for row in rows]
 
     assert without_timing(on_ray) == without_timing(here)
+
+
+def test_scripted_feature_answers_follow_the_user_model():
+    from dialog.regress.feature_study import UserModel, hfr_answer, hfs_answer
+
+    names = ("colour.red", "size.height", "location.x", "arm.joint1", "weight")
+    relevant = {"colour.red", "size.height", "weight"}
+    perfect = UserModel(keep_relevant=1.0, add_irrelevant=0.0, ignore_robot=1.0, ignore_irrelevant_object=1.0,
+                        ignore_relevant=0.0)
+    rng = np.random.default_rng(0)
+    assert hfs_answer(names, relevant, perfect, rng).tolist() == [0, 1, 4]
+    assert hfr_answer(names, relevant, perfect, rng).tolist() == [0, 1, 4]
+    lax = UserModel(ignore_robot=0.0, ignore_irrelevant_object=0.0, ignore_relevant=0.0)
+    assert hfr_answer(names, relevant, lax, rng).tolist() == [0, 1, 2, 3, 4]  # ignoring nothing keeps all
+
+
+def test_stratified_samples_are_balanced_and_disjoint():
+    from dialog.regress.feature_study import srs
+
+    concepts = np.array(["a", "b"] * 20, dtype=object)
+    rng = np.random.default_rng(1)
+    first = srs(concepts, 10, rng)
+    second = srs(concepts, 10, rng, exclude=first)
+    assert sorted(concepts[first].tolist()) == ["a"] * 5 + ["b"] * 5
+    assert not set(first) & set(second)
+    with pytest.raises(ValueError, match="free rows of 'a'"):
+        srs(concepts, 50, rng)
