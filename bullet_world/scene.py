@@ -16,6 +16,9 @@ class SceneTruth:
     body_ids: tuple[int, ...]
     positions: np.ndarray  # (n, 3) true centres from the simulator
     sizes: np.ndarray      # (n, 3) true length, width, height
+    states: tuple[str, ...] = ()     # state of each object ("boxed", "in-pot"; "as-is" when a kind has none)
+    masses: tuple[float, ...] = ()   # true mass, kg
+    yaws: tuple[float, ...] = ()     # true yaw on the counter, radians
 
 
 @dataclass(frozen=True)
@@ -29,6 +32,8 @@ class Scene:
     tops: np.ndarray                  # (n,) perceived top height of each object
     colours: np.ndarray               # (n, 3) perceived mean colour in 0..1
     truth: SceneTruth = field(repr=False)
+    outlines: np.ndarray | None = field(default=None, repr=False)  # (n, 4, 2) perceived footprint box corners
+    stage: int = 0                    # how many state changes the world has been through (prepare-lunch)
 
     @property
     def n_objects(self) -> int:

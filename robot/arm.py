@@ -86,16 +86,42 @@ class Arm:
 
     # -- proprioception ------------------------------------------------------
     def proprioception(self) -> dict[str, float]:
-        """Joint angles, the hand's position relative to the base, and the gripper opening.
+        """The robot's features (thesis Table 5.1): base location and yaw (in the kitchen and relative to
+        the counter), joint angles, the hand's pose relative to the body and to the counter, hand state.
 
-        The keys are the ``source = "robot"`` features of ``bullet_world/data/features.toml``.
+        The keys, in order, are the ``source = "robot"`` features of ``bullet_world/data/features.toml``.
         """
-        joints = self.joint_positions()
-        hand = self.fingertip_position() - self.base_position
-        values = {f"arm.joint{j + 1}": float(q) for j, q in enumerate(joints)}
-        values.update({"hand.x": float(hand[0]), "hand.y": float(hand[1]), "hand.z": float(hand[2]),
-                       "hand.opening": self.finger_opening()})
+        counter_x, counter_y = self.world.kitchen.counter_centre
+        yaw = float(self.world.kitchen.robot_yaw)
+        values = {"arm.base.x": float(self.base_position[0]), "arm.base.y": float(self.base_position[1]),
+                  "arm.base.z": float(self.base_position[2]), "arm.base.yaw": yaw,
+                  "arm.base.counter_x": float(self.base_position[0] - counter_x),
+                  "arm.base.counter_y": float(self.base_position[1] - counter_y), "arm.base.counter_yaw": yaw}
+        values.update({f"arm.joint{j + 1}": float(q) for j, q in enumerate(self.joint_positions())})
+        position, orientation = self._hand_pose()
+        inverse = p.invertTransform(self.base_position.tolist(), self.base_orientation)
+        body_position, body_orientation = p.multiplyTransforms(*inverse, position, orientation)
+        values.update(self._pose_features("hand", body_position, body_orientation))
+        counter_position = (position[0] - counter_x, position[1] - counter_y, position[2])  # counter top is z = 0
+        values.update(self._pose_features("hand.counter", counter_position, orientation))
+        opening = self.finger_opening()
+        values.update({"hand.opening": opening, "hand.closed": float(opening < self.HAND_CLOSED_BELOW_M)})
         return values
+
+    HAND_CLOSED_BELOW_M = 0.04  # the hand counts as closed when its fingers are less than half open
+
+    @staticmethod
+    def _pose_features(prefix: str, position, orientation) -> dict[str, float]:
+        """``prefix.x/y/z`` and ``prefix.qx/qy/qz/qw`` of one pose (quaternion with qw >= 0, so it is unique)."""
+        quaternion = np.asarray(orientation, dtype=float) * (1.0 if orientation[3] >= 0 else -1.0)
+        names = ("x", "y", "z", "qx", "qy", "qz", "qw")
+        return {f"{prefix}.{name}": float(value) for name, value in zip(names, (*position, *quaternion))}
+
+    def _hand_pose(self) -> tuple[tuple, tuple]:
+        """World position and orientation (quaternion) of the point between the fingertips."""
+        state = p.getLinkState(self.body_id, FINGERTIP_LINK, computeForwardKinematics=True,
+                               physicsClientId=self.client)
+        return tuple(state[4]), tuple(state[5])
 
     # -- kinematics and motion ------------------------------------------------
     def inverse_kinematics(self, position, yaw: float = 0.0) -> np.ndarray:

@@ -1,10 +1,14 @@
-"""The simulated kitchen: reproducible scenes, perception against the simulator's truth."""
+"""The simulated kitchen: reproducible scenes, perception against the simulator's truth, kitchens."""
 
 import numpy as np
 import pytest
 
 from bullet_world import World
-from bullet_world.catalogue import DataFileError, load_kitchen, load_object_kinds, load_task
+from bullet_world.catalogue import DataFileError, load_kitchen, load_task
+from bullet_world.check import scene_errors
+from bullet_world.kitchen import INTEREST_POINTS
+
+KITCHENS = ("kitchen-1", "kitchen-2", "kitchen-3")
 
 
 def test_same_seed_same_scene():
@@ -13,7 +17,7 @@ def test_same_seed_same_scene():
         b = second.new_scene(np.random.default_rng(11))
     assert a.feature_names == b.feature_names
     assert np.array_equal(a.X, b.X)
-    assert a.truth.kinds == b.truth.kinds
+    assert a.truth.kinds == b.truth.kinds and np.array_equal(a.truth.positions, b.truth.positions)
 
 
 def test_different_seeds_differ():
@@ -23,66 +27,70 @@ def test_different_seeds_differ():
     assert not np.allclose(a.X, b.X)
 
 
+def test_sensor_noise_is_seeded_and_can_be_switched_off():
+    with World(seed=1) as noisy, World(seed=1, sensor_noise=False) as clean:
+        rng_a, rng_b = np.random.default_rng(3), np.random.default_rng(3)
+        noisy.new_scene(rng_a)
+        clean.new_scene(rng_b)
+        first, second = noisy.observe(), noisy.observe()
+        assert not np.array_equal(first.X, second.X)  # a new look, new sensor noise
+        assert np.array_equal(clean.observe().X, clean.observe().X)
+
+
 def test_perception_matches_the_simulator(kitchen):
     scene = kitchen.next_scene(np.random.default_rng(7))
     truth = scene.truth
     assert scene.n_objects == kitchen.world.task.objects_per_scene
     assert set(truth.concepts) == set(kitchen.concepts)  # stratified: every concept present
-    size_error = np.abs(np.column_stack([scene.feature("size.length"), scene.feature("size.width"),
-                                         scene.feature("size.height")]) - truth.sizes)
-    location_error = np.linalg.norm(scene.positions[:, :2] - truth.positions[:, :2], axis=1)
-    assert np.median(size_error) < 0.005 and size_error.max() < 0.02
-    assert np.median(location_error) < 0.005 and location_error.max() < 0.015
+    size_error, location_error = scene_errors(scene)
+    assert np.median(size_error) < 0.005 and np.median(location_error) < 0.005
+    assert location_error.max() < 0.02
 
 
-def test_robot_features_join_the_feature_vector(kitchen):
-    names = kitchen.feature_names
-    assert "arm.joint1" in names and "hand.z" in names and names[0] == "colour.red"
-    scene = kitchen.next_scene(np.random.default_rng(8))
-    assert scene.X.shape == (scene.n_objects, len(names))
-    joint = scene.feature("arm.joint4")
-    assert np.all(joint == joint[0])  # one arm state per observation
+@pytest.mark.parametrize("name", KITCHENS)
+def test_every_kitchen_holds_a_scene_and_sees_every_object(name):
+    with World(kitchen=name, seed=2, objects_per_scene=20) as world:
+        scene = world.new_scene(np.random.default_rng(4))
+        kitchen = world.kitchen
+        assert scene.n_objects == 20
+        assert np.all(kitchen.in_object_region(scene.truth.positions[:, :2]))
+        size_error, location_error = scene_errors(scene)
+        assert np.median(size_error) < 0.005 and np.median(location_error) < 0.005
+
+
+def test_kitchens_differ_in_layout_and_objects():
+    kitchens = [load_kitchen(name) for name in KITCHENS]
+    layouts = {tuple(np.round(k.locations["stove"].centre, 2)) for k in kitchens}
+    bases = {(k.robot_base, round(k.robot_yaw, 2)) for k in kitchens}
+    assert len(layouts) == 3 and len(bases) == 3
+    task = load_task("pack-lunchbox")
+    object_sets = {tuple(k.name for k in task.kinds_in(name)) for name in KITCHENS}
+    assert len(object_sets) == 3
+
+
+@pytest.mark.parametrize("name", KITCHENS)
+def test_kitchen_locations_are_regions_within_reach(name):
+    kitchen = load_kitchen(name)
+    assert set(INTEREST_POINTS) <= set(kitchen.locations)
+    base = np.asarray(kitchen.robot_base[:2])
+    for location in kitchen.locations.values():
+        centre, half = np.asarray(location.centre[:2]), np.asarray(location.half_size)
+        assert location.contains(centre) and not location.contains(centre + half + 0.01)
+        corners = centre + half * np.array([[1, 1], [1, -1], [-1, 1], [-1, -1]])
+        distances = np.linalg.norm(corners - base, axis=1)
+        assert np.all(distances < 0.8) and np.all(distances >= kitchen.min_reach)
 
 
 def test_unknown_names_list_what_exists():
     with pytest.raises(DataFileError, match="available: .*pack-lunchbox"):
         load_task("no-such-task")
-    with pytest.raises(DataFileError, match="available: .*kitchen-1"):
+    with pytest.raises(DataFileError, match="available: .*kitchen-1.*kitchen-3"):
         load_kitchen("kitchen-99")
 
 
-def test_broken_object_file_names_the_field(tmp_path):
-    path = tmp_path / "objects.toml"
-    path.write_text('[[kind]]\nname = "x"\nconcept = "fruit"\nshape = "cube"\n')
-    with pytest.raises(DataFileError, match="shape 'cube' is not one of box, cylinder, sphere"):
-        load_object_kinds(path)
-    path.write_text('[[kind]]\nname = "x"\nconcept = "fruit"\nshape = "sphere"\nradius = [0.05]\n'
-                    'colours = [[1, 0, 0]]\ncolour_jitter = 0.0\nmass = [0.1, 0.2]\n')
-    with pytest.raises(DataFileError, match="'radius' must be a list of 2 numbers"):
-        load_object_kinds(path)
-    path.write_text("this is = = not toml")
-    with pytest.raises(DataFileError, match="not valid TOML"):
-        load_object_kinds(path)
-
-
-def test_kitchen_locations_are_regions_within_reach():
-    kitchen = load_kitchen("kitchen-1")
-    assert {"stove", "fridge", "cupboard", "pantry", "counter"} <= set(kitchen.locations)
-    base = np.asarray(kitchen.robot_base[:2])
-    for location in kitchen.locations.values():
-        assert location.contains(location.centre[:2])
-        corner = np.asarray(location.centre[:2]) + np.asarray(location.half_size)
-        assert not location.contains(corner + 0.01)
-        assert np.linalg.norm(np.asarray(location.centre[:2]) - base) < 0.8
-
-
-def test_every_feature_has_a_name_group_and_description(kitchen):
-    from bullet_world.features import feature_info
-
-    infos = feature_info(kitchen.feature_names)
-    assert [info.name for info in infos] == list(kitchen.feature_names)
-    for info in infos:
-        assert info.group.count("/") >= 1 and len(info.description) > 15
+def test_object_count_outside_the_task_range_is_refused():
+    with pytest.raises(ValueError, match="objects_per_scene must be between 4 and 55"):
+        World(objects_per_scene=80)
 
 
 def test_objects_can_be_added_and_removed_by_hand():
@@ -94,3 +102,23 @@ def test_objects_can_be_added_and_removed_by_hand():
         assert np.allclose(scene.positions[0, :2], (0.1, 0.0), atol=0.005)
         world.remove_object(body)
         assert world.object_bodies == () and world.observe().X.shape == (0, len(world.feature_names))
+
+
+def test_a_draw_without_a_colour_index_still_builds():
+    with World(seed=2, sensor_noise=False) as world:
+        kind = next(k for k in world.task.kinds if k.name == "soda-can")
+        draw = {"dimensions": {"radius": 0.032, "height": 0.12}, "colour": [0.8, 0.05, 0.1], "mass": 0.38}
+        world.add_object(kind, (0.0, 0.1), 0.3, draw=draw)
+        scene = world.observe()
+        assert scene.feature("colour.red")[0] > 2 * scene.feature("colour.green")[0]
+        assert scene.feature("size.height")[0] == pytest.approx(0.12, abs=0.004)
+
+
+def test_lighting_changes_measured_colour_but_not_size():
+    with World(seed=3, sensor_noise=False) as world:
+        before = world.new_scene(np.random.default_rng(5))
+        after = world.change_lighting(np.random.default_rng(6))
+    brightness = before.feature("colour.value") - after.feature("colour.value")
+    assert np.abs(brightness).mean() > 0.02
+    assert np.array_equal(before.feature("size.length"), after.feature("size.length"))
+    assert before.feature("light.level")[0] != after.feature("light.level")[0]

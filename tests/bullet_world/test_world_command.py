@@ -1,0 +1,42 @@
+"""``teachbot world show`` and ``teachbot world check`` through the command line."""
+
+import json
+
+import cv2
+
+from dialog.cli import main
+
+
+def test_world_show_writes_an_annotated_picture(tmp_path, capsys):
+    out = tmp_path / "scene.png"
+    assert main(["world", "show", "--kitchen", "kitchen-2", "--seed", "3", "--objects", "8", "--png", str(out)]) == 0
+    picture = cv2.imread(str(out))
+    assert picture is not None and picture.shape[0] > 300
+    printed = capsys.readouterr().out
+    assert "8 objects in kitchen-2" in printed and " 8. " in printed
+
+
+def test_world_show_refuses_a_bad_file_name(tmp_path, capsys):
+    assert main(["world", "show", "--png", str(tmp_path / "scene.jpg")]) == 2
+    assert "--png must name a .png file" in capsys.readouterr().err
+
+
+def test_world_check_ends_with_one_json_line(capsys):
+    assert main(["world", "check", "--objects", "12", "--per-scene", "6", "--kitchen", "kitchen-1",
+                 "--json"]) == 0
+    last = capsys.readouterr().out.strip().splitlines()[-1]
+    result = json.loads(last)
+    assert set(result) >= {"objects", "size_err_mm", "loc_err_mm", "features", "ms_per_scene"}
+    assert result["objects"] >= 12 and set(result["size_err_mm"]) == {"median", "p95"}
+    assert result["size_err_mm"]["median"] < 5 and result["loc_err_mm"]["median"] < 5
+
+
+def test_world_data_builds_then_reuses_the_cache(tmp_path, capsys):
+    arguments = ["world", "data", "--task", "prepare-lunch", "--no-robot", "--cache", str(tmp_path), "--json"]
+    assert main(arguments) == 0
+    first = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
+    assert first["train"] == [80] * 5 and first["test"] == 40 and first["features"] == 56
+    assert main(arguments) == 0
+    captured = capsys.readouterr()
+    assert json.loads(captured.out.strip().splitlines()[-1])["file"] == first["file"]
+    assert "pool" not in captured.err  # nothing rendered the second time
