@@ -55,19 +55,20 @@ class ConceptModels:
         self.subsets_ = {c: subsets.get(c) for c in self.concepts}
         self.models_ = {}
         for concept in self.concepts:
-            columns = self._columns(concept, X.shape[1])
+            columns = self.columns(concept, X.shape[1])
             model = BinaryGPClassifier(self.length_scale, self.variance)
             self.models_[concept] = model.fit(X[:, columns], labels == concept)
         return self
 
-    def _columns(self, concept: str, n_features: int) -> np.ndarray:
+    def columns(self, concept: str, n_features: int) -> np.ndarray:
+        """The feature columns the classifier of ``concept`` uses (all when it has no subset)."""
         subset = self.subsets_.get(concept)
         return np.arange(n_features) if subset is None or len(subset) == 0 else np.asarray(subset)
 
     def predict(self, X: np.ndarray) -> np.ndarray:
         """(n, |Y|) matrix of p(y | x) for standardised rows ``X``."""
         return np.column_stack([
-            self.models_[c].predict_proba(X[:, self._columns(c, X.shape[1])]) for c in self.concepts
+            self.models_[c].predict_proba(X[:, self.columns(c, X.shape[1])]) for c in self.concepts
         ])
 
 

@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Hashable, Iterable
+from functools import lru_cache
 
 import numpy as np
 from scipy.stats import chi2
@@ -38,6 +39,17 @@ DEFAULT_SIGNIFICANCE = 0.05
 MAX_DEFAULT_BINS = 10
 _RELATIVE_TOLERANCE = 1e-12
 _COPY_TOLERANCE = 1e-9
+
+
+@lru_cache(maxsize=4096)
+def _chi2_quantile(probability: float, degrees: int) -> float:
+    return float(chi2.ppf(probability, degrees))
+
+
+def _chi2_quantiles(probability: float, degrees: np.ndarray) -> np.ndarray:
+    """chi2.ppf for an array of (few distinct) degrees of freedom, each computed once."""
+    distinct, inverse = np.unique(degrees, return_inverse=True)
+    return np.array([_chi2_quantile(probability, int(d)) for d in distinct])[inverse.reshape(-1)]
 
 
 def default_bin_count(n_samples: int) -> int:
@@ -102,22 +114,28 @@ def _resolve_method(method) -> str:
 
 
 def _discretize(features: np.ndarray, n_bins: int) -> np.ndarray:
+    """Equal-frequency codes for all columns at once (vectorised; see the module docstring)."""
     n_samples, n_features = features.shape
-    codes = np.empty(features.shape, dtype=np.intp)
-    ordered = np.sort(features, axis=0)
-    # Bin i starts at sorted position floor(i n / n_bins): sizes differ by at most one.
+    order = np.argsort(features, axis=0, kind="stable")
+    ordered = np.take_along_axis(features, order, axis=0)
+    # A column with no more distinct values than bins keeps them: code = rank among its distinct values.
+    new_value = np.vstack([np.zeros((1, n_features), dtype=np.intp), np.diff(ordered, axis=0) != 0])
+    value_ranks = np.empty((n_samples, n_features), dtype=np.intp)
+    np.put_along_axis(value_ranks, order, np.cumsum(new_value, axis=0), axis=0)
+    few_values = value_ranks.max(axis=0, initial=0) + 1 <= n_bins
+    if np.all(few_values):
+        return value_ranks
+    # Bin i starts at sorted position floor(i n / n_bins): sizes differ by at most one. Cuts halfway
+    # between neighbours; a value's raw bin is the number of cuts at or below it.
     split_positions = (np.arange(1, n_bins) * n_samples) // n_bins
-    for column in range(n_features):
-        values, sorted_values = features[:, column], ordered[:, column]
-        distinct = np.unique(sorted_values)
-        if distinct.size <= n_bins:
-            codes[:, column] = np.searchsorted(distinct, values)
-            continue
-        below, above = sorted_values[split_positions - 1], sorted_values[split_positions]
-        raw_bins = np.searchsorted(below + (above - below) / 2.0, values, side="right")
-        # Ties at a cut can merge or empty bins: renumber the occupied ones 0..K-1.
-        codes[:, column] = np.unique(raw_bins, return_inverse=True)[1].reshape(-1)
-    return codes
+    below, above = ordered[split_positions - 1], ordered[split_positions]
+    cuts = below + (above - below) / 2.0
+    raw_bins = (features[:, None, :] >= cuts[None, :, :]).sum(axis=1)
+    # Ties at a cut can merge or empty bins: renumber the occupied ones 0..K-1.
+    occupied = np.zeros((n_bins, n_features), dtype=bool)
+    occupied[raw_bins, np.arange(n_features)[None, :]] = True
+    renumbered = np.take_along_axis(np.cumsum(occupied, axis=0) - 1, raw_bins, axis=0)
+    return np.where(few_values[None, :], value_ranks, renumbered)
 
 
 def discretize(X, n_bins: int | None = None) -> np.ndarray:
@@ -155,6 +173,8 @@ class _DiscreteFeatures:
         self.entropies = self._entropy(self.one_hot, self.starts)
         self.inverse_bin_sizes = np.add.reduceat(1.0 / self.one_hot.sum(axis=0), self.starts)
         self._feature_su: np.ndarray | None = None
+        self._su_rows: dict[int, np.ndarray] = {}
+        self._class_tables: dict[bytes, tuple] = {}
 
     def _entropy(self, one_hot: np.ndarray, starts: np.ndarray) -> np.ndarray:
         return _joint_entropies(np.ones((self.n_samples, 1)), one_hot, starts)[0]
@@ -164,10 +184,14 @@ class _DiscreteFeatures:
         return entropy + (cells - 1) / (2.0 * self.n_samples * math.log(2.0))
 
     def _against_class(self, class_codes: np.ndarray):
-        """H(Y), its cell count, and H(Y, f) with occupied cells for every feature."""
-        class_one_hot = np.eye(int(class_codes.max()) + 1)[class_codes]
-        joint, cells = _joint_entropies(class_one_hot, self.one_hot, self.starts)
-        return self._entropy(class_one_hot, np.array([0]))[0], class_one_hot.shape[1], joint, cells
+        """H(Y), its cell count, and H(Y, f) with occupied cells for every feature (kept per class vector)."""
+        key = class_codes.tobytes()
+        if key not in self._class_tables:
+            class_one_hot = np.eye(int(class_codes.max()) + 1)[class_codes]
+            joint, cells = _joint_entropies(class_one_hot, self.one_hot, self.starts)
+            self._class_tables = {key: (self._entropy(class_one_hot, np.array([0]))[0], class_one_hot.shape[1],
+                                        joint, cells)}
+        return self._class_tables[key]
 
     def gains(self, class_codes: np.ndarray) -> np.ndarray:
         """Plug-in I(Y; f) = H(Y) + H(f) - H(Y, f) in bits for every feature (eq. 5.1)."""
@@ -183,7 +207,7 @@ class _DiscreteFeatures:
         williams = 1.0 + (n * self.inverse_bin_sizes - 1.0) * (n * np.sum(1.0 / class_sizes) - 1.0) / (
             6.0 * n * safe_degrees
         )
-        critical = williams * chi2.ppf(1.0 - significance, safe_degrees) / (2.0 * n * math.log(2.0))
+        critical = williams * _chi2_quantiles(1.0 - significance, safe_degrees) / (2.0 * n * math.log(2.0))
         return np.where(degrees > 0, self.gains(class_codes) - critical, 0.0)
 
     def class_su(self, class_codes: np.ndarray, significance: float) -> np.ndarray:
@@ -209,6 +233,51 @@ class _DiscreteFeatures:
             totals = marginals[:, None] + marginals[None, :]
             self._feature_su = _symmetrical_uncertainty((mutual + mutual.T) / 2.0, totals)
         return self._feature_su
+
+    def feature_su_row(self, feature: int) -> np.ndarray:
+        """One row of ``feature_su``, computed alone (forward selection needs only the chosen rows)."""
+        if self._feature_su is not None:
+            return self._feature_su[feature]
+        if feature not in self._su_rows:
+            marginals = self._miller_madow(self.entropies, self.levels)
+            start = self.starts[feature]
+            block = self.one_hot[:, start : start + self.levels[feature]]
+            joint, cells = _joint_entropies(block, self.one_hot, self.starts)
+            mutual = marginals[feature] + marginals - self._miller_madow(joint, cells)
+            row = _symmetrical_uncertainty(mutual, marginals[feature] + marginals)
+            row[feature] = 1.0 if marginals[feature] > 0 else 0.0
+            self._su_rows[feature] = row
+        return self._su_rows[feature]
+
+
+class _LazyCorrelations:
+    """Feature-feature SU rows on demand: what ES reads of the matrix (rows of chosen features)."""
+
+    def __init__(self, table: _DiscreteFeatures):
+        self.table = table
+
+    def __getitem__(self, feature: int) -> np.ndarray:
+        return self.table.feature_su_row(int(feature))
+
+    def representatives(self, features: np.ndarray) -> np.ndarray:
+        """Mask over ``features``: those whose partition no lower-indexed one of them already has.
+
+        Two features are exact copies (SU = 1) exactly when their bins partition the samples the same
+        way; comparing partitions (bins renamed in order of first appearance) finds them without SU rows.
+        """
+        codes = self.table.codes[:, features]
+        values = np.arange(int(codes.max(initial=0)) + 1)[:, None, None]
+        is_value = codes[None, :, :] == values  # (value, sample, feature)
+        first_seen = np.where(is_value.any(axis=1), is_value.argmax(axis=1), codes.shape[0])
+        rank_of_value = np.argsort(np.argsort(first_seen, axis=0, kind="stable"), axis=0, kind="stable")
+        canonical = np.take_along_axis(rank_of_value, codes, axis=0).T.astype(np.int16)  # bins renamed
+        seen: set[bytes] = set()
+        keep = np.zeros(len(features), dtype=bool)
+        for column, partition in enumerate(canonical):
+            signature = partition.tobytes()
+            keep[column] = signature not in seen
+            seen.add(signature)
+        return keep
 
 
 def _prepare(X, y, n_bins) -> tuple[_DiscreteFeatures, np.ndarray]:
@@ -311,11 +380,22 @@ def _representatives(feature_su: np.ndarray) -> np.ndarray:
     return ~np.triu(feature_su >= 1.0 - _COPY_TOLERANCE, k=1).any(axis=0)
 
 
-def _forward(class_su: np.ndarray, feature_su: np.ndarray, max_features: int | None) -> np.ndarray:
+def _forward(class_su: np.ndarray, feature_su, max_features: int | None) -> np.ndarray:
+    """Greedy CFS forward search; ``feature_su`` is the SU matrix or ``_LazyCorrelations`` (rows on demand)."""
     n_features = class_su.size
     if not np.any(class_su > 0):
         return np.arange(n_features)
-    eligible, chosen = _representatives(feature_su), np.zeros(n_features, dtype=bool)
+    # Only features with r_cf > 0 can raise the merit (a zero adds nothing above the line and grows the
+    # denominator), and an exact copy has the same r_cf as its original: look for copies among those.
+    relevant = np.flatnonzero(class_su > 0)
+    if isinstance(feature_su, _LazyCorrelations):
+        # Copies have the same SU with the class (up to rounding): look for them only if two values meet.
+        may_copy = np.any(np.diff(np.sort(class_su[relevant])) < _COPY_TOLERANCE)
+        distinct = feature_su.representatives(relevant) if may_copy else np.ones(len(relevant), dtype=bool)
+    else:
+        distinct = _representatives(feature_su[np.ix_(relevant, relevant)])
+    eligible, chosen = np.zeros(n_features, dtype=bool), np.zeros(n_features, dtype=bool)
+    eligible[relevant[distinct]] = True
     links = np.zeros(n_features)  # SU summed between each feature and the chosen ones
     sum_class, pairs, merit, size = 0.0, 0.0, 0.0, 0
     while size < (max_features or n_features):
@@ -366,7 +446,7 @@ def forward_selection(
     _check_count(max_features, "max_features", 1)
     significance = _check_significance(significance)
     table, class_codes = _prepare(X, y, n_bins)
-    return _forward(table.class_su(class_codes, significance), table.feature_su, max_features)
+    return _forward(table.class_su(class_codes, significance), _LazyCorrelations(table), max_features)
 
 
 def backward_elimination(X, y, *, significance: float = DEFAULT_SIGNIFICANCE, n_bins: int | None = None) -> np.ndarray:
@@ -387,7 +467,7 @@ def _select(table: _DiscreteFeatures, class_codes: np.ndarray, method: str, sign
         if chosen.size:
             return chosen
     if method == "ES":
-        return _forward(table.class_su(class_codes, significance), table.feature_su, None)
+        return _forward(table.class_su(class_codes, significance), _LazyCorrelations(table), None)
     if method == "ER":
         return _backward(table.class_su(class_codes, significance), table.feature_su)
     return np.arange(table.n_features)

@@ -43,7 +43,14 @@ class LearningState:
         self.history: list[str] = []  # action kind of every finished turn
         self.scene_X = np.zeros((0, len(self.feature_names)))
         self.scene_id = -1
-        self.asked_in_scene: set[int] = set()
+        self.asked_in_scene: set[int] = set()  # label queries asked in this scene
+        self.demonstrated_in_scene: set[int] = set()  # scene objects the teacher showed as demonstrations
+        self.absent_in_scene: set[str] = set()  # concepts the teacher could not show in this scene
+        self._examples_at_last_turn = 0
+        self.last_query_scene_id: int | None = None  # scene of the most recent query (None: never asked)
+        self.version = 0  # bumps whenever the models are refit (what-if caches key on it)
+        self.training_version = 0  # bumps whenever the training set changes
+        self.cache: dict = {}  # what-if engines keep (version, value) entries here
         self.scaler = FeatureScaler(len(self.feature_names))
         self.models = ConceptModels(self.concepts, variance=variance, length_scale=length_scale)
         self._scene_P: np.ndarray | None = None
@@ -58,6 +65,8 @@ class LearningState:
         if scene_id != self.scene_id:
             self.scene_id, self.scene_X = scene_id, X
             self.asked_in_scene = set()
+            self.demonstrated_in_scene = set()
+            self.absent_in_scene = set()
             self.scaler.update(X)
             self.refit()
 
@@ -65,14 +74,28 @@ class LearningState:
     def add_example(self, x: np.ndarray, concept: str, source: str) -> None:
         if concept not in self.concepts:
             raise ValueError(f"unknown concept '{concept}'; known: {', '.join(self.concepts)}")
-        self.examples.append(Example(np.asarray(x, dtype=float), concept, source, self.scene_id))
+        x = np.asarray(x, dtype=float)
+        self.examples.append(Example(x, concept, source, self.scene_id))
+        if source == "demo":
+            self.demonstrated_in_scene.update(self._scene_rows_equal_to(x))
+        self.training_version += 1
         self.refit()
+
+    def _scene_rows_equal_to(self, x: np.ndarray) -> set[int]:
+        if x.shape != (len(self.feature_names),) or len(self.scene_X) == 0:
+            return set()
+        return set(np.flatnonzero(np.all(self.scene_X == x, axis=1)).tolist())
 
     def remove_last_example(self) -> Example | None:
         """Take back the most recent example (the teacher's "undo")."""
         if not self.examples:
             return None
         example = self.examples.pop()
+        if example.source == "demo" and example.scene_id == self.scene_id:
+            still_shown = {i for e in self.examples if e.source == "demo" and e.scene_id == self.scene_id
+                           for i in self._scene_rows_equal_to(e.x)}
+            self.demonstrated_in_scene &= still_shown
+        self.training_version += 1
         self.refit()
         return example
 
@@ -95,6 +118,11 @@ class LearningState:
             self.feature_query_asked = True
         if action.kind == "label":
             self.asked_in_scene.add(action.object_index)
+        if action.kind == "demo" and len(self.examples) == self._examples_at_last_turn:
+            self.absent_in_scene.add(action.concept)  # asked, but no example came back
+        self._examples_at_last_turn = len(self.examples)
+        if action.kind != "none":
+            self.last_query_scene_id = self.scene_id
         self.turn += 1
 
     # -- budget -------------------------------------------------------------------
@@ -108,6 +136,21 @@ class LearningState:
     def can_afford(self, action: Action) -> bool:
         return self.cost(action) <= self.remaining_budget + 1e-9
 
+    # -- interaction history ---------------------------------------------------------
+    @property
+    def labelled_in_scene(self) -> set[int]:
+        """Scene objects whose concept the teacher already gave in this scene (asked or demonstrated)."""
+        return self.asked_in_scene | self.demonstrated_in_scene
+
+    def quiet_run(self) -> int:
+        """How many turns in a row, up to now, the learner asked nothing."""
+        run = 0
+        for kind in reversed(self.history):
+            if kind != "none":
+                break
+            run += 1
+        return run
+
     # -- models -------------------------------------------------------------------
     def training_matrix(self) -> tuple[np.ndarray, np.ndarray]:
         if not self.examples:
@@ -118,6 +161,16 @@ class LearningState:
         X, labels = self.training_matrix()
         self.models.fit(self.scaler.transform(X), labels, self.feature_subsets)
         self._scene_P = None
+        self.version += 1
+
+    def scaled_training(self) -> tuple[np.ndarray, np.ndarray]:
+        """The training rows as the models see them (standardised) and their concept names."""
+        X, labels = self.training_matrix()
+        return self.scaler.transform(X), labels
+
+    def scaled_scene(self) -> np.ndarray:
+        """The current scene's rows, standardised like the training rows."""
+        return self.scaler.transform(self.scene_X)
 
     def probabilities(self, X: np.ndarray | None = None) -> np.ndarray:
         """(n, |Y|) p(y|x) for ``X`` (default: the current scene, cached)."""

@@ -1,27 +1,63 @@
 """Questioning strategies: each looks at the learning state and returns one Decision.
 
 ``make_strategy(name)`` builds one by name; ``STRATEGY_NAMES`` lists them all.
+
+========== ==================================================================
+passive    P: demonstrations only, the least represented concept first
+active     A: label queries by uncertainty (entropy, eq. 6.1)
+random     R: any affordable query at random
+hfs-passive HFS+P: the feature query first, then P
+hfs-active HFS+A: the feature query first, then A
+all-cd     All/CD: feature query, a few demos keeping classes uniform, then A
+dt         DT with the weights in learning/weights/dt.toml (or ``weights=``)
+dt-iros    DT on ACD and CDU (thesis ch. 6)
+dt-task    DT on ACD, CDU, IV and PM (thesis ch. 7)
+dt-task-env DT on all seven decision features (thesis ch. 7; IRL weights)
+========== ==================================================================
 """
 
 from __future__ import annotations
 
-from learning.strategies.active import ActiveStrategy
-from learning.strategies.base import Strategy
-from learning.strategies.passive import PassiveStrategy
+from functools import partial
 
-STRATEGIES: dict[str, type[Strategy]] = {
+from learning.strategies.active import ActiveStrategy
+from learning.strategies.all_cd import AllClassDistributionStrategy
+from learning.strategies.base import Strategy
+from learning.strategies.decision_theoretic import DecisionTheoreticStrategy
+from learning.strategies.hfs import HfsActiveStrategy, HfsPassiveStrategy
+from learning.strategies.passive import PassiveStrategy
+from learning.strategies.random_choice import RandomStrategy
+
+STRATEGIES = {
     "passive": PassiveStrategy,
     "active": ActiveStrategy,
+    "random": RandomStrategy,
+    "hfs-passive": HfsPassiveStrategy,
+    "hfs-active": HfsActiveStrategy,
+    "all-cd": AllClassDistributionStrategy,
+    "dt": partial(DecisionTheoreticStrategy, "dt"),
+    "dt-iros": partial(DecisionTheoreticStrategy, "dt-iros"),
+    "dt-task": partial(DecisionTheoreticStrategy, "dt-task"),
+    "dt-task-env": partial(DecisionTheoreticStrategy, "dt-task-env"),
 }
 STRATEGY_NAMES = tuple(STRATEGIES)
 
 
-def make_strategy(name: str) -> Strategy:
-    """The strategy called ``name``; a clear error lists the accepted names."""
-    key = name.strip().lower()
+def make_strategy(name: str, **options) -> Strategy:
+    """The strategy called ``name``; a clear error lists the accepted names.
+
+    Options go to the strategy's constructor, e.g. ``make_strategy("dt", weights={...}, engine="reference")``
+    or ``make_strategy("all-cd", examples_per_concept=3)``.
+    """
+    key = str(name).strip().lower()
     if key not in STRATEGIES:
         raise ValueError(f"unknown strategy '{name}'; choose one of: {', '.join(STRATEGY_NAMES)}")
-    return STRATEGIES[key]()
+    if key == "dt" and "weights" in options:
+        return DecisionTheoreticStrategy(name="dt", **options)
+    try:
+        return STRATEGIES[key](**options)
+    except TypeError as error:
+        raise ValueError(f"strategy '{key}' does not take the options {sorted(options)} ({error})") from None
 
 
-__all__ = ["STRATEGIES", "STRATEGY_NAMES", "Strategy", "make_strategy"]
+__all__ = ["STRATEGIES", "STRATEGY_NAMES", "DecisionTheoreticStrategy", "Strategy", "make_strategy"]

@@ -22,7 +22,7 @@ class ActiveStrategy(Strategy):
             return self.out_of_budget(state)
         P = state.probabilities()
         scores = entropy(P)
-        for index in state.asked_in_scene:
+        for index in state.labelled_in_scene:
             scores[index] = -np.inf
         if len(scores) == 0 or not np.isfinite(scores.max()):
             return Decision(NoQuery(), "Nothing to ask: I already asked about every object in this scene.")

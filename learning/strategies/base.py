@@ -23,3 +23,11 @@ class Strategy(ABC):
     def out_of_budget(state: LearningState) -> Decision:
         return Decision(NoQuery(), f"Nothing to ask: my question budget is spent ({state.spent:g} of "
                                    f"{state.budget:g}).")
+
+    @classmethod
+    def nothing_affordable(cls, state: LearningState) -> Decision:
+        """No query left to ask: the budget is short, or every object in the scene is already labelled."""
+        if state.remaining_budget < min(state.costs[k] for k in ("label", "demo", "feature")) - 1e-9:
+            return cls.out_of_budget(state)
+        return Decision(NoQuery(), "Nothing to ask: I already know every object in this scene and can't "
+                                   "afford anything else.")

@@ -1,14 +1,16 @@
 """Passive baseline P: only demonstration queries (thesis §6.4.1).
 
 Simulates stratified sampling: ask for the concept with the fewest examples so
-far, breaking ties at random, so that the class distribution stays uniform.
+far, breaking ties at random, so that the class distribution stays uniform. A
+concept the teacher could not show in this scene is not asked for again until
+the scene changes.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from learning.actions import Decision, DemoQuery
+from learning.actions import Decision, DemoQuery, NoQuery
 from learning.state import LearningState
 from learning.strategies.base import Strategy
 
@@ -17,9 +19,11 @@ class PassiveStrategy(Strategy):
     name = "passive"
 
     def choose(self, state: LearningState, rng: np.random.Generator) -> Decision:
-        counts = state.counts_per_concept()
+        counts = {c: n for c, n in state.counts_per_concept().items() if c not in state.absent_in_scene}
+        if not counts:
+            return Decision(NoQuery(), "Nothing to ask: none of the concepts can be shown in this scene.")
         fewest = min(counts.values())
-        candidates = [c for c in state.concepts if counts[c] == fewest]
+        candidates = [c for c in counts if counts[c] == fewest]
         concept = candidates[int(rng.integers(len(candidates)))]
         action = DemoQuery(concept)
         if not state.can_afford(action):

@@ -367,3 +367,29 @@ def test_module_imports_no_simulator_viewer_or_application_code():
     result = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, check=True)
     assert result.stdout.strip() == "[]"
     assert importlib.util.find_spec("learning.feature_selection") is not None
+
+
+# ---------------------------------------------------------------- speed-ups keep the results
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 10_000), st.sampled_from([0.05, 0.5]))
+def test_forward_search_on_rows_on_demand_equals_the_full_matrix_search(seed, significance):
+    from learning.feature_selection import _forward, _LazyCorrelations, _prepare, _representatives
+
+    rng = np.random.default_rng(seed)
+    n_samples, n_features = int(rng.integers(5, 120)), int(rng.integers(2, 30))
+    y = rng.integers(0, int(rng.integers(2, 5)), n_samples)
+    X = rng.normal(size=(n_samples, n_features))
+    X[:, : min(3, n_features)] += rng.normal(0, 2, (5, min(3, n_features)))[y]
+    if n_features > 4:
+        X[:, -1], X[:, -2] = X[:, 0], 5.0 - 2.0 * X[:, 1]  # exact and decreasing copies
+    if seed % 3 == 0:
+        X = np.round(X)  # ties and few distinct values
+    table, codes = _prepare(X, y, None)
+    class_su = table.class_su(codes, significance)
+    lazy = _forward(class_su, _LazyCorrelations(table), None)
+    assert np.array_equal(lazy, _forward(class_su, table.feature_su, None))
+    relevant = np.flatnonzero(class_su > 0)
+    assert np.array_equal(_LazyCorrelations(table).representatives(relevant),
+                          _representatives(table.feature_su[np.ix_(relevant, relevant)]))

@@ -44,3 +44,17 @@ def test_one_example_leans_positive_near_it_and_prior_far_away():
 def test_shape_mismatch_is_a_clear_error():
     with pytest.raises(ValueError, match="one row per label"):
         BinaryGPClassifier().fit(np.zeros((3, 2)), [1, 0])
+
+
+def test_concept_models_start_from_the_prior_and_learn_from_one_example(rng):
+    from learning.concepts import ConceptModels
+
+    models = ConceptModels(("a", "b", "c"), length_scale=1.0)
+    assert models.variance == 4.0 and not hasattr(models, "models_")  # the constructor only stores parameters
+    X = rng.normal(size=(4, 2))
+    assert models.fit(np.zeros((0, 2)), [], {}) is models
+    assert np.allclose(models.predict(X), 0.5)
+    models.fit(np.zeros((1, 2)), ["b"], {"a": np.array([1])})
+    near = models.predict(np.zeros((1, 2)))[0]
+    assert near[1] > 0.6 and near[0] == pytest.approx(0.5, abs=0.2) and near[2] < 0.4
+    assert models.columns("a", 2).tolist() == [1] and models.columns("b", 2).tolist() == [0, 1]

@@ -1,0 +1,90 @@
+"""Decision-theoretic arbitration DT (thesis §6.4.2 eq. 6.2-6.3, §7.3.1 eq. 7.1-7.2).
+
+For every affordable candidate the what-if engine simulates every answer and
+``learning.decision`` turns the simulated next states into E[phi(s') | a].
+With weights w the expected utility is EU(a) = w . E[phi(s') | a]; the learner
+takes the best query a* only if EU(a*) > U(s), else it asks nothing this turn.
+Ties between queries go to the first in candidate order (demos, labels, FSQ).
+
+Named presets read their weights from learning/weights/<name>.toml:
+``dt`` (custom: edit the file or pass ``weights=``), ``dt-iros`` (ACD, CDU),
+``dt-task`` (+ IV, PM) and ``dt-task-env`` (+ budget, time, non-query time;
+its file is where IRL's learned weights go).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from learning.actions import Action, Decision
+from learning.concepts import normalise_rows
+from learning.decision import CandidateFeatures, expected_decision_features
+from learning.decision_weights import resolve_weights
+from learning.state import LearningState
+from learning.strategies.base import Strategy
+from learning.whatif import make_engine
+
+GAIN_TOLERANCE = 1e-12
+
+
+class DecisionTheoreticStrategy(Strategy):
+    """DT with any weight vector: a preset name, a TOML path, a {feature: weight} mapping or a full vector."""
+
+    def __init__(self, weights="dt", name: str | None = None, engine="fast", window_factor: float = 1.0):
+        self.weights = resolve_weights(weights)
+        self.name = name or (weights if isinstance(weights, str) and not weights.endswith(".toml") else "dt")
+        self.engine = make_engine(engine)
+        self.window_factor = window_factor
+        self.last_candidates: CandidateFeatures | None = None  # what the last choice saw (for IRL recording)
+
+    def choose(self, state: LearningState, rng: np.random.Generator) -> Decision:
+        candidates = expected_decision_features(state, self.engine, self.window_factor)
+        self.last_candidates = candidates
+        if len(candidates.actions) == 1:
+            return self.nothing_affordable(state)
+        utilities = candidates.utilities(self.weights)
+        best, stay = choose_index(utilities), candidates.no_query_index
+        if best == stay:
+            queries = utilities[:-1]
+            top = int(np.argmax(queries))
+            return Decision(candidates.actions[stay], _quiet_reason(state, candidates.actions[top], queries[top],
+                                                                      utilities[stay]))
+        action = candidates.actions[best]
+        return Decision(action, _query_reason(state, action, utilities[best], utilities[stay]))
+
+
+def choose_index(utilities: np.ndarray) -> int:
+    """argmax over the candidates, no query (the last) unless a query beats it by more than rounding."""
+    queries, stay = utilities[:-1], utilities[-1]
+    if len(queries) == 0:
+        return len(utilities) - 1
+    top = int(np.argmax(queries))  # ties: the first in candidate order
+    return top if queries[top] > stay + GAIN_TOLERANCE * max(1.0, abs(stay)) else len(utilities) - 1
+
+
+def _describe(state: LearningState, action: Action) -> str:
+    if action.kind == "label":
+        return f"asking what object {action.object_index + 1} is"
+    if action.kind == "demo":
+        return f"asking for a demonstration of {action.concept}"
+    return "asking which features matter"
+
+
+def _query_reason(state: LearningState, action: Action, utility: float, quiet: float) -> str:
+    numbers = f"expected utility {utility:.3f} against {quiet:.3f} if I stay quiet"
+    if action.kind == "label":
+        P = normalise_rows(state.probabilities())
+        first, second = (state.concepts[i] for i in np.argsort(P[action.object_index])[::-1][:2])
+        return f"I can't tell {first} from {second} for object {action.object_index + 1}, so I ask ({numbers})."
+    if action.kind == "demo":
+        count = state.counts_per_concept()[action.concept]
+        return (f"A demonstration of {action.concept} should help most: I have {count} "
+                f"example{'s' if count != 1 else ''} of it ({numbers}).")
+    return f"Knowing which features matter should help most ({numbers})."
+
+
+def _quiet_reason(state: LearningState, best: Action, utility: float, quiet: float) -> str:
+    numbers = f"{_describe(state, best)} is worth {utility:.3f} against {quiet:.3f} for staying quiet"
+    if state.last_query_scene_id is not None and state.last_query_scene_id == state.scene_id:
+        return f"Nothing to ask: the scene hasn't changed since my last question ({numbers})."
+    return f"Nothing to ask: no question is worth its cost now ({numbers})."

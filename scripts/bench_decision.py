@@ -1,0 +1,141 @@
+"""Interaction-time benchmark of the decision-theoretic choice: fast what-if engine vs the brute-force reference.
+
+Both engines score every candidate action (|Y| demos, |X| labels, the feature
+query when it is still open, no query) of the same seeded learning states and
+the DT rule picks one (thesis eq. 6.3, 7.1). States come from
+``learning.synthetic.random_state``: |Y| = 4 concepts, |F| = 90 features of
+which 6 are informative, a scene of |X| objects, n_train labelled examples
+with uneven classes, some budget spent and a random recent history; in about
+half of them the teacher has already answered the feature query.
+
+Timing: the decision only (expected decision features of every candidate +
+argmax); the learner's current p(y|x) is part of the state and computed
+before the clock starts. Each fast timing is the best of ``--repeats`` cold
+runs (the state's cache cleared before each); the reference is timed once.
+BLAS runs on one thread unless ``--threads`` says otherwise. ``fast_ms`` and
+``reference_ms`` are wall-clock; ``fast_cpu_ms`` is this process's CPU time
+for the same runs, which other programs on a busy machine do not inflate; the
+load average at the start and end is printed and reported.
+
+    python scripts/bench_decision.py --json        # last line: one JSON object per size
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+
+
+def _parse(argv):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--states", type=int, default=40, help="seeded states per size (default 40)")
+    parser.add_argument("--reference-states-large", type=int, default=6,
+                        help="states per size that also run the reference when n_train >= 500 (default 6)")
+    parser.add_argument("--objects", type=int, nargs="+", default=[12, 55], help="scene sizes |X| (default 12 55)")
+    parser.add_argument("--train", type=int, nargs="+", default=[20, 150, 500],
+                        help="training-set sizes (default 20 150 500)")
+    parser.add_argument("--weights", default="dt-task-env", help="DT weights: preset name or TOML path")
+    parser.add_argument("--repeats", type=int, default=5, help="cold runs per fast timing, best kept (default 5)")
+    parser.add_argument("--threads", type=int, default=1, help="BLAS threads (default 1)")
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--json", action="store_true", help="end with one JSON line (a list, one object per size)")
+    args = parser.parse_args(argv)
+    for name in ("states", "reference_states_large", "repeats", "threads"):
+        if getattr(args, name) < 1:
+            parser.error(f"--{name.replace('_', '-')} must be at least 1, got {getattr(args, name)}")
+    return args
+
+
+ARGS = _parse(sys.argv[1:]) if __name__ == "__main__" else None
+if ARGS is not None:  # BLAS reads these once, when numpy is first imported
+    for variable in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+        os.environ[variable] = str(ARGS.threads)
+
+import json  # noqa: E402
+import time  # noqa: E402
+
+import numpy as np  # noqa: E402
+
+from learning.decision import expected_decision_features  # noqa: E402
+from learning.decision_weights import resolve_weights  # noqa: E402
+from learning.strategies.decision_theoretic import choose_index  # noqa: E402
+from learning.synthetic import SyntheticTask, random_state  # noqa: E402
+
+LARGE_TRAINING_SET = 500
+
+
+def decide(state, engine: str, weights: np.ndarray):
+    candidates = expected_decision_features(state, engine)
+    utilities = candidates.utilities(weights)
+    return candidates, utilities, choose_index(utilities)
+
+
+def measure_size(n_objects: int, n_train: int, args, weights: np.ndarray) -> dict:
+    task = SyntheticTask(seed=args.seed)
+    rng = np.random.default_rng([args.seed, n_objects, n_train])
+    with_reference = args.states if n_train < LARGE_TRAINING_SET else min(args.states, args.reference_states_large)
+    fast_ms, fast_cpu_ms, reference_ms, same, regrets, eu_errors, open_fsq = [], [], [], [], [], [], 0
+    for index in range(args.states):
+        state = random_state(task, n_train, n_objects, rng, feature_query_answered=bool(rng.random() < 0.5))
+        state.probabilities()  # the learner's current beliefs belong to the state, not to the decision
+        open_fsq += not state.feature_query_asked
+        best, best_cpu = np.inf, np.inf
+        for _ in range(args.repeats):
+            state.cache.clear()
+            started, started_cpu = time.perf_counter(), time.process_time()
+            candidates, fast_utilities, fast_choice = decide(state, "fast", weights)
+            best = min(best, time.perf_counter() - started)
+            best_cpu = min(best_cpu, time.process_time() - started_cpu)
+        fast_ms.append(1e3 * best)
+        fast_cpu_ms.append(1e3 * best_cpu)
+        if index >= with_reference:
+            continue
+        started = time.perf_counter()
+        reference, reference_utilities, reference_choice = decide(state, "reference", weights)
+        reference_ms.append(1e3 * (time.perf_counter() - started))
+        assert reference.actions == candidates.actions
+        same.append(fast_choice == reference_choice)
+        regrets.append(float(reference_utilities[reference_choice] - reference_utilities[fast_choice]))
+        eu_errors.append(float(np.max(np.abs(fast_utilities - reference_utilities))))
+    fast_p50, reference_p50 = np.percentile(fast_ms, 50), np.percentile(reference_ms, 50)
+    return {
+        "scene_objects": n_objects, "n_train": n_train,
+        "fast_ms": {"p50": round(float(fast_p50), 2), "p95": round(float(np.percentile(fast_ms, 95)), 2)},
+        "fast_cpu_ms": {"p50": round(float(np.percentile(fast_cpu_ms, 50)), 2),
+                        "p95": round(float(np.percentile(fast_cpu_ms, 95)), 2)},
+        "reference_ms": {"p50": round(float(reference_p50), 1),
+                         "p95": round(float(np.percentile(reference_ms, 95)), 1)},
+        "speedup": round(float(reference_p50 / fast_p50), 1),
+        "same_action": round(float(np.mean(same)), 4),
+        "max_regret": float(f"{max(regrets):.3g}"),
+        "max_eu_error": float(f"{max(eu_errors):.3g}"),
+        "states": args.states, "reference_states": with_reference, "feature_query_open": open_fsq,
+        "load_average": round(os.getloadavg()[0], 2),
+    }
+
+
+def main(args) -> int:
+    weights = resolve_weights(args.weights)
+    results = []
+    print(f"DT decision, weights {args.weights}, |Y| = 4, |F| = 90, BLAS threads {args.threads}, "
+          f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} CPUs")
+    print(f"{'|X|':>4} {'n':>4} | {'fast p50':>9} {'p95':>7} | {'cpu p50':>8} {'p95':>7} | {'ref p50':>9} {'p95':>9} | "
+          f"{'speedup':>8} | {'same':>5} {'max regret':>10} {'max EU err':>10} | states (ref) | load")
+    for n_train in args.train:
+        for n_objects in args.objects:
+            row = measure_size(n_objects, n_train, args, weights)
+            results.append(row)
+            print(f"{n_objects:>4} {n_train:>4} | {row['fast_ms']['p50']:>7.2f}ms {row['fast_ms']['p95']:>5.1f}ms | "
+                  f"{row['fast_cpu_ms']['p50']:>6.2f}ms {row['fast_cpu_ms']['p95']:>5.1f}ms | "
+                  f"{row['reference_ms']['p50']:>7.0f}ms {row['reference_ms']['p95']:>7.0f}ms | "
+                  f"{row['speedup']:>7.0f}x | {row['same_action']:>5.2f} {row['max_regret']:>10.2g} "
+                  f"{row['max_eu_error']:>10.2g} | {row['states']} ({row['reference_states']}) | "
+                  f"{row['load_average']:.1f}", flush=True)
+    if args.json:
+        print(json.dumps(results))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(ARGS))
