@@ -1,8 +1,14 @@
-"""The dialog manager: the timed, budgeted teaching loop (thesis §6.3.2, §7.3.3).
+"""The dialog manager: the timed, budgeted teaching loop (thesis §6.3.2, §7.3.1, §7.3.3).
 
-Each turn: observe (a new scene every ``change_every`` turns), let the strategy
-choose one action, realise it (point, ask, listen), update the learner, and
-append the turn to the transcript before the next one begins.
+Each turn: observe (a new scene every ``change_every`` turns, or, in real-time
+mode, whenever the world's own clock says so), let the strategy choose one
+action, realise it (point, ask, listen, learn), and append the turn to the
+transcript before the next one begins. At most one query per turn; once the
+budget is spent only "no query" remains.
+
+``play_turn(action)`` realises one given action, so that a person (expert
+mode) can choose the questions instead of a strategy; ``run(replay=records)``
+first replays recorded turns into a fresh state (``--resume``).
 """
 
 from __future__ import annotations
@@ -13,24 +19,40 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from dialog.clock import VirtualClock
+from dialog.conversation import Outcome, converse
 from dialog.environment import Environment
-from dialog.teachers import Answer, Teacher
+from dialog.parsing import AnswerParser
+from dialog.questions import Prompt, Questioner, acknowledgement, question_text
+from dialog.records import action_from_record, action_record, answer_record, outcome_from_record
 from dialog.transcript import TranscriptWriter
 from learning.actions import DEFAULT_COSTS, Action, NoQuery
 from learning.evaluation import accuracy
 from learning.state import LearningState
 from learning.strategies import Strategy
 
+__all__ = ["DialogManager", "EpisodeConfig", "EpisodeResult", "episode_generators", "question_text"]
+
+STREAMS = ("scenes", "test", "strategy", "teacher", "pantry")
+
 
 @dataclass
 class EpisodeConfig:
-    """One episode's allocation: T turns, budget B, a scene change every r turns."""
+    """One episode's allocation: T turns, budget B, a scene change every r turns.
+
+    realtime: seconds per turn (None: turn-based); a late answer counts as none.
+    pictures: folder for numbered scene pictures (None: no pictures).
+    fetch_from_pantry: fetch an example the teacher says is absent, where the task allows.
+    """
 
     turns: int = 30
     budget: float = 40.0
     change_every: int = 5
     seed: int = 0
     costs: dict = field(default_factory=lambda: dict(DEFAULT_COSTS))
+    realtime: float | None = None
+    pictures: str | None = None
+    fetch_from_pantry: bool = True
 
     def __post_init__(self):
         if self.turns < 1:
@@ -39,6 +61,8 @@ class EpisodeConfig:
             raise ValueError(f"budget must be zero or more, got {self.budget}")
         if self.change_every < 1:
             raise ValueError(f"change-every must be at least 1 turn, got {self.change_every}")
+        if self.realtime is not None and not self.realtime > 0:
+            raise ValueError(f"realtime must be a positive number of seconds per turn, got {self.realtime}")
 
 
 @dataclass
@@ -51,88 +75,294 @@ class EpisodeResult:
     accuracy: float
     transcript: str
     seconds: float
+    completed: int = 0
+    quit: bool = False
 
 
 def episode_generators(seed: int) -> dict[str, np.random.Generator]:
     """Independent random streams from one seed, one per consumer."""
-    names = ("scenes", "test", "strategy", "teacher")
-    children = np.random.SeedSequence(seed).spawn(len(names))
-    return {name: np.random.default_rng(child) for name, child in zip(names, children)}
-
-
-def question_text(action: Action, object_number: int | None = None) -> str:
-    if action.kind == "label":
-        return f"What is this (object {object_number})?"
-    if action.kind == "demo":
-        return f"Can you show me a {action.concept}?"
-    if action.kind == "feature":
-        return "Which features tell these things apart?"
-    return ""
+    children = np.random.SeedSequence(seed).spawn(len(STREAMS))
+    return {name: np.random.default_rng(child) for name, child in zip(STREAMS, children)}
 
 
 class DialogManager:
-    """Runs one episode of the loop with any environment, teacher and strategy."""
+    """Runs one episode of the loop with any environment, teacher and strategy.
 
-    def __init__(self, environment: Environment, teacher: Teacher, strategy: Strategy, config: EpisodeConfig,
+    Observers may define ``on_scene(scene)``, ``on_question(action, text, scene)``,
+    ``on_answer(action, outcome, scene)`` and ``on_turn(record, scene)``.
+    """
+
+    def __init__(self, environment: Environment, teacher, strategy: Strategy, config: EpisodeConfig,
                  transcript: TranscriptWriter, rngs: dict[str, np.random.Generator], say=print,
-                 observers: tuple = ()):
+                 observers: tuple = (), clock=None, parser: AnswerParser | None = None, session: dict | None = None):
         self.env, self.teacher, self.strategy = environment, teacher, strategy
-        self.config, self.transcript, self.rngs, self.say = config, transcript, rngs, say
+        self.config, self.transcript, self.say = config, transcript, say
+        self.rngs = dict(rngs)
+        if "pantry" not in self.rngs:
+            self.rngs["pantry"] = episode_generators(config.seed)["pantry"]
         self.observers = tuple(observers)
+        self.clock = clock or VirtualClock()
+        self.parser = parser or AnswerParser(environment.concepts)
+        self.session = dict(session or {})
         self.state = LearningState(environment.concepts, environment.feature_names, config.budget, config.turns,
                                    costs=config.costs, change_every=config.change_every)
+        self.scene = None
+        self.turn = 0  # turns finished
+        self.quit = False
+        self.replay_mismatches = 0
+        self._epoch = -1
+        self._test = None
+        self._undo_stack: list[tuple] = []
+        self.questioner = Questioner(environment, self.state, config.pictures)
 
-    def run(self) -> EpisodeResult:
+    # -- episode ------------------------------------------------------------------
+    def header(self) -> dict:
+        config = self.config
+        return {"seed": config.seed, "turns": config.turns, "budget": config.budget,
+                "change_every": config.change_every, "realtime": config.realtime, "costs": dict(config.costs),
+                "fetch_from_pantry": config.fetch_from_pantry, "strategy": self.strategy.name,
+                "concepts": list(self.env.concepts), "features": len(self.env.feature_names), **self.session}
+
+    def begin(self) -> None:
+        """Draw the held-out test set and write the session header (once)."""
+        if self._test is None:
+            self._test = self.env.test_set(getattr(self.env, "test_scenes", 4), self.rngs["test"])
+        if not self.transcript.has_content:
+            self.transcript.write_header(self.header())
+
+    def run(self, replay: list[dict] = ()) -> EpisodeResult:
+        """Play the episode; recorded turns in ``replay`` are re-applied first, without asking anyone."""
         started = time.perf_counter()
-        test_X, test_y = self.env.test_set(getattr(self.env, "test_scenes", 4), self.rngs["test"])
-        scene = None
-        for turn in range(self.config.turns):
-            if turn % self.config.change_every == 0:
-                scene = self.env.next_scene(self.rngs["scenes"])
-                self.state.observe_scene(scene.scene_id, scene.X)
-                self._notify("on_scene", scene)
-                self.say(f"-- turn {turn + 1}: the robot looks at a new scene of {scene.n_objects} objects")
-            record = self._turn(turn, scene)
-            record["accuracy"] = round(accuracy(self.state.predict(test_X), test_y), 6)
-            self.transcript.write(record)
-            self._notify("on_turn", record, scene)
-        final = accuracy(self.state.predict(test_X), test_y)
+        self.begin()
+        replay = list(replay)
+        while self.turn < self.config.turns and not self.quit:
+            if self.turn < len(replay):
+                self.replay_turn(replay[self.turn])
+            else:
+                self.play_turn()
+        return self.finish(time.perf_counter() - started)
+
+    def finish(self, seconds: float = 0.0) -> EpisodeResult:
+        test_X, test_y = self._test
         kinds = Counter(self.state.history)
         return EpisodeResult(
             seed=self.config.seed, strategy=self.strategy.name, turns=self.config.turns,
             budget_spent=self.state.spent,
             queries={"label": kinds["label"], "demo": kinds["demo"], "feature": kinds["feature"],
                      "none": kinds["none"]},
-            accuracy=final, transcript=str(self.transcript.path), seconds=time.perf_counter() - started,
+            accuracy=accuracy(self.state.predict(test_X), test_y), transcript=str(self.transcript.path),
+            seconds=seconds, completed=self.turn, quit=self.quit,
         )
 
-    def _turn(self, turn: int, scene) -> dict:
-        decision = self.strategy.choose(self.state, self.rngs["strategy"])
-        action = decision.action if self.state.can_afford(decision.action) else NoQuery()
-        record = {"turn": turn + 1, "scene_id": scene.scene_id, "action": _action_record(action),
-                  "explanation": decision.explanation}
-        if action.kind == "none":
-            answer = Answer("")
-            self.say(f"Turn {turn + 1:>3} · Robot stays quiet. ({decision.explanation})")
+    # -- the clock and the world ---------------------------------------------------
+    def _start_turn(self, recorded_scene: int | None = None) -> float:
+        """Wait for the turn's slot (real time), and change the scene when it is due."""
+        config = self.config
+        if config.realtime:
+            self.clock.sleep_until(self.turn * config.realtime)
+            start = self.clock.now()
+            epoch = int(start // (config.change_every * config.realtime))
         else:
-            number = action.object_index + 1 if action.kind == "label" else None
-            question = question_text(action, number)
+            start = self.clock.now()
+            epoch = self.turn // config.change_every
+        due = self.scene is None or epoch > self._epoch
+        if recorded_scene is not None:
+            due = self.scene is None or recorded_scene != self.scene.scene_id
+        if due:
+            self.scene = self.env.next_scene(self.rngs["scenes"])
+            self._epoch = max(epoch, self._epoch + 1)
+            self.state.observe_scene(self.scene.scene_id, self.scene.X)
+            self._notify("on_scene", self.scene)
+            self.say(f"-- turn {self.turn + 1}: the robot looks at a new scene of {self.scene.n_objects} objects")
+        return start
+
+    def admissible(self, action: Action) -> tuple[Action, str]:
+        """The action itself if it may be taken now, else no query and the reason."""
+        state, scene = self.state, self.scene
+        if action.kind == "none":
+            return action, ""
+        if not state.can_afford(action):
+            return NoQuery(), f"Nothing to ask: the budget is spent ({state.spent:g} of {state.budget:g})."
+        if action.kind == "feature" and state.feature_query_asked:
+            return NoQuery(), "I already asked which features matter."
+        if action.kind == "label" and not 0 <= action.object_index < scene.n_objects:
+            return NoQuery(), f"There is no object {action.object_index + 1} in this scene."
+        if action.kind == "demo" and action.concept not in state.concepts:
+            return NoQuery(), f"'{action.concept}' is not a concept of this task."
+        return action, ""
+
+    # -- one turn -----------------------------------------------------------------------
+    def play_turn(self, action: Action | None = None, explanation: str = "") -> dict | None:
+        """Choose (or take the given) action and realise it; None when the teacher quit."""
+        start = self._start_turn()
+        if action is None:
+            decision = self.strategy.choose(self.state, self.rngs["strategy"])
+            action, explanation = decision.action, decision.explanation
+        chosen = action
+        action, reason = self.admissible(chosen)
+        return self.realise(action, reason or explanation, start, chosen)
+
+    def realise(self, action: Action, explanation: str, start: float, chosen: Action | None = None) -> dict | None:
+        """Point, ask, listen and learn for one action; append the turn's record. None if the teacher quit."""
+        scene, number = self.scene, self.turn + 1
+        record = {"turn": number, "time": round(start, 3), "scene_id": scene.scene_id,
+                  "action": action_record(action), "explanation": explanation}
+        if chosen is not None and chosen != action:
+            record["strategy_action"] = action_record(chosen)
+        if action.kind == "none":
+            outcome = Outcome("none")
+            self.say(f"Turn {number:>3} · Robot stays quiet. ({explanation})")
+        else:
             if action.kind == "label":
                 record["gesture"] = self.env.point_at(scene, action.object_index)
-                lead = f"Robot (pointing at object {number})"
-            else:
-                lead = "Robot"
-            answer = self.teacher.answer(action, question, scene)
-            self._apply(action, answer, scene)
-            record["question"] = question
-            self.say(f"Turn {turn + 1:>3} · {lead}: {question}   Teacher: {answer.raw}")
+                self.clock.advance(record["gesture"].get("sim_seconds", 0.0))
+            prompt = self.prompt_for(action, explanation, number, start)
+            record["question"] = prompt.text
+            if prompt.picture:
+                record["picture"] = prompt.picture
+            self._notify("on_question", action, prompt.text, scene)
+            outcome, undone = self._ask(prompt)
+            if outcome.kind == "quit":
+                self.quit = True
+                self.say(f"Turn {number:>3} · the teacher ended the session ({outcome.note or 'quit'}).")
+                return None
+            for _ in undone:
+                self._undo()
+            if undone:
+                record["undid"] = undone
+            record.update(self._apply(action, outcome, scene))
+            message = acknowledgement(prompt, outcome.kind, outcome.value, self.env.feature_names)
+            if "fetched" in record:
+                message = f"There's none here, so I fetched one from the pantry ({record['fetched']['kind']})."
+            if message:
+                self.teacher_tell(message)
+            self._notify("on_answer", action, outcome, scene)
+            lead = f"Robot (pointing at object {action.object_index + 1})" if action.kind == "label" else "Robot"
+            self.say(f"Turn {number:>3} · {lead}: {prompt.text}   Teacher: {outcome.raw}")
+        return self._close_turn(record, action, outcome)
+
+    def _close_turn(self, record: dict, action: Action, outcome: Outcome) -> dict:
         self.state.record_turn(action)
+        test_X, test_y = self._test
         record.update({
-            "answer": {"raw": answer.raw, "parsed": _jsonable(answer.value)},
+            "answer": answer_record(outcome, action, self.state.feature_names),
             "cost": self.state.cost(action), "budget_left": self.state.remaining_budget,
-            "model": {"examples": self.state.counts_per_concept()},
+            "model": self.model_summary(),
+            "ended": round(self.clock.now(), 3),
+            "accuracy": round(accuracy(self.state.predict(test_X), test_y), 6),
         })
+        self.transcript.write(record)
+        self.turn += 1
+        self._notify("on_turn", record, self.scene)
         return record
+
+    def _ask(self, prompt: Prompt) -> tuple[Outcome, list[int]]:
+        """Converse until the question ends; "undo" takes back earlier answers (applied once it ends)."""
+        lines, undone = [], []
+        while True:
+            outcome = converse(self.teacher, prompt, self.parser, self.clock)
+            lines += outcome.lines
+            if outcome.kind != "undo":
+                break
+            if len(undone) >= len(self._undo_stack):
+                self.teacher_tell("There is nothing left to take back.")
+                continue
+            turn, what = self._undo_stack[-1 - len(undone)][:2]
+            undone.append(turn)
+            self.teacher_tell(f"Taken back: {what} (turn {turn}). {prompt.text}")
+        outcome.lines = lines
+        return outcome, undone
+
+    def teacher_tell(self, text: str) -> None:
+        tell = getattr(self.teacher, "tell", None)
+        if tell is not None:
+            tell(text)
+
+    def prompt_for(self, action: Action, explanation: str, number: int, start: float, pictures: bool = True) -> Prompt:
+        """The question for ``action`` with its details (table, picture, feature tree)."""
+        deadline = start + self.config.realtime if self.config.realtime else None
+        return self.questioner.prompt(self.scene, action, explanation, number, deadline, pictures)
+
+    # -- answers -------------------------------------------------------------------------
+    def _apply(self, action: Action, outcome: Outcome, scene, replaying: bool = False) -> dict:
+        """Learn from the outcome; returns extra transcript fields (a pantry fetch)."""
+        state, extra = self.state, {}
+        if outcome.kind == "answer" and action.kind == "label":
+            state.add_example(scene.X[action.object_index], outcome.value, "label")
+            self._undo_stack.append((self.turn + 1, f"number {action.object_index + 1} is {outcome.value}",
+                                     "example"))
+        elif outcome.kind == "answer" and action.kind == "demo":
+            state.add_example(scene.X[outcome.value], action.concept, "demo")
+            self._undo_stack.append((self.turn + 1, f"number {outcome.value + 1} is {action.concept}", "example"))
+        elif outcome.kind == "absent" and action.kind == "demo" and self._may_fetch(action.concept):
+            fetched = self.env.fetch(scene, action.concept, self.rngs["pantry"])
+            if fetched is not None:
+                state.add_example(fetched["x"], action.concept, "demo")
+                self._undo_stack.append((self.turn + 1, f"the {action.concept} from the pantry", "example"))
+                self.clock.advance(fetched.get("sim_seconds", 0.0))
+                extra["fetched"] = {key: fetched[key] for key in ("kind", "position") if key in fetched}
+        elif outcome.kind == "answer" and action.kind == "feature":
+            previous = dict(state.feature_subsets)
+            state.set_feature_subset(list(outcome.value))
+            self._undo_stack.append((self.turn + 1, f"the choice of {len(outcome.value)} features", "features",
+                                     previous))
+        return extra
+
+    def _may_fetch(self, concept: str) -> bool:
+        can = getattr(self.env, "can_fetch", None)
+        return bool(self.config.fetch_from_pantry and can is not None and can(concept))
+
+    def _undo(self) -> int:
+        """Take back the latest learned answer; returns its turn."""
+        entry = self._undo_stack.pop()
+        if entry[2] == "example":
+            self.state.remove_last_example()
+        else:
+            self.state.feature_subsets = dict(entry[3])
+            self.state.refit()
+        return entry[0]
+
+    def model_summary(self) -> dict:
+        subsets = [s for s in self.state.feature_subsets.values() if s is not None]
+        in_use = len(subsets[0]) if subsets else len(self.state.feature_names)
+        return {"examples": self.state.counts_per_concept(), "features_in_use": in_use}
+
+    # -- resume ---------------------------------------------------------------------------
+    def replay_turn(self, record: dict) -> None:
+        """Re-apply one recorded turn: same scene, same gesture, same answer; nobody is asked."""
+        number = self.turn + 1
+        if int(record.get("turn", -1)) != number:
+            raise ValueError(f"transcript turn records are out of order: expected turn {number}, got "
+                             f"{record.get('turn')}")
+        self._start_turn(recorded_scene=int(record["scene_id"]))
+        if self.scene.scene_id != record["scene_id"]:
+            raise ValueError(f"turn {number} was recorded in scene {record['scene_id']} but the replay is in scene "
+                             f"{self.scene.scene_id}: the transcript was made with another seed, task or kitchen")
+        decision = self.strategy.choose(self.state, self.rngs["strategy"])  # keeps the strategy's stream in step
+        action = action_from_record(record["action"])
+        if decision.action != action:
+            self.replay_mismatches += 1
+        if action.kind == "label":
+            self.env.point_at(self.scene, action.object_index)
+        forward = getattr(self.teacher, "fast_forward", None)
+        if action.kind != "none" and forward is not None:
+            forward(self.prompt_for(action, decision.explanation, number, float(record.get("time", 0)), False))
+        for _ in record.get("undid", []):
+            self._undo()
+        outcome = outcome_from_record(record, action, self.state.feature_names)
+        extra = self._apply(action, outcome, self.scene, replaying=True)
+        if "fetched" in record and extra.get("fetched", {}).get("kind") != record["fetched"].get("kind"):
+            raise ValueError(f"turn {number}: the pantry fetch did not repeat ({extra.get('fetched')} instead of "
+                             f"{record['fetched']})")
+        self.state.record_turn(action)
+        recorded = record.get("model", {}).get("examples")
+        if recorded is not None and recorded != self.state.counts_per_concept():
+            raise ValueError(f"turn {number}: replaying the transcript gives {self.state.counts_per_concept()} "
+                             f"examples, the transcript says {recorded}")
+        if "ended" in record:
+            self.clock.set(float(record["ended"]))
+        self.turn += 1
+        self._notify("on_turn", record, self.scene)
 
     def _notify(self, event: str, *payload) -> None:
         """Tell observers (a viewer, a progress display) what happened; they may not change the episode."""
@@ -140,30 +370,3 @@ class DialogManager:
             handler = getattr(observer, event, None)
             if handler is not None:
                 handler(*payload)
-
-    def _apply(self, action: Action, answer: Answer, scene) -> None:
-        if answer.value is None:
-            return
-        if action.kind == "label":
-            self.state.add_example(scene.X[action.object_index], answer.value, "label")
-        elif action.kind == "demo":
-            self.state.add_example(scene.X[answer.value], action.concept, "demo")
-        elif action.kind == "feature":
-            self.state.set_feature_subset(answer.value)
-
-
-def _action_record(action: Action) -> dict:
-    record = {"kind": action.kind}
-    if action.kind == "label":
-        record["object"] = action.object_index + 1
-    elif action.kind == "demo":
-        record["concept"] = action.concept
-    return record
-
-
-def _jsonable(value):
-    if isinstance(value, (np.integer,)):
-        return int(value)
-    if isinstance(value, (tuple, list, np.ndarray)):
-        return [_jsonable(v) for v in value]
-    return value

@@ -1,4 +1,19 @@
-"""Teachers answer the robot's questions; all share one small interface."""
+"""Teachers answer the robot's questions, all behind one small interface.
+
+A teacher is shown a :class:`~dialog.questions.Prompt`, answers with one line
+of text at a time (``listen``; None means no more input, or no answer before
+the deadline), and hears the robot's replies (``tell``). The same parser reads
+every teacher's lines, so scripted runs exercise what a person would type.
+
+- :class:`ScriptedTeacher`: an oracle from the hidden ground truth, with a
+  mislabel rate, a "don't know" rate, a feature-answer quality and an answer
+  delay, all drawn from one seeded generator.
+- :class:`ReplayTeacher`: the lines of a recorded transcript, turn by turn.
+- ``dialog.terminal.TerminalTeacher``: a person at the terminal.
+
+Older teachers with ``answer(action, question, scene) -> Answer`` (value
+already parsed) still work: the manager uses their value as given.
+"""
 
 from __future__ import annotations
 
@@ -7,40 +22,151 @@ from typing import Protocol
 
 import numpy as np
 
-from bullet_world import Scene
-from learning.actions import Action
+from dialog.clock import VirtualClock
+from dialog.questions import Prompt, article
+
+DELAY_SHAPE = 4.0  # answer delays are gamma-distributed with this shape around the mean
 
 
 @dataclass(frozen=True)
 class Answer:
-    """What the teacher said (``raw``) and what it means (``value``; None = no usable answer).
-
-    label query: a concept name; demonstration: an object index (None: none in
-    the scene); feature query: a tuple of feature indices.
-    """
+    """A pre-parsed answer from an older-style teacher: ``raw`` text and its ``value`` (None = none)."""
 
     raw: str
     value: object = None
 
 
 class Teacher(Protocol):
-    def answer(self, action: Action, question: str, scene: Scene) -> Answer: ...
+    def show(self, prompt: Prompt) -> None: ...
+
+    def listen(self, prompt: Prompt, deadline: float | None) -> str | None: ...
+
+    def tell(self, text: str) -> None: ...
 
 
-class OracleTeacher:
-    """A scripted teacher that answers from the scene's hidden ground truth."""
+def relevant_feature_indices(prompt: Prompt) -> list[int]:
+    """The features that matter for the task: ``Task.relevant_features`` or, without it, every object feature."""
+    tree = prompt.feature_tree
+    names = tree.feature_names
+    if prompt.relevant_features:
+        chosen = [names.index(n) for n in prompt.relevant_features if n in names]
+        if chosen:
+            return chosen
+    chosen = [i for i in range(len(names)) if tree.group_of(i).startswith("object")]
+    return chosen or list(range(len(names)))
 
-    def __init__(self, rng: np.random.Generator):
+
+class ScriptedTeacher:
+    """An oracle teacher with seeded imperfections.
+
+    mislabel_rate: chance that a label names a wrong concept (and that a
+    demonstration shows an object of another concept). dont_know_rate: chance
+    of answering "I don't know". feature_quality q in [0, 1]: each relevant
+    feature is chosen with probability q, and about (1 - q) x as many irrelevant
+    ones are added. answer_delay: mean seconds per answer (gamma distributed),
+    spent on the injected clock.
+    """
+
+    def __init__(self, rng: np.random.Generator, mislabel_rate: float = 0.0, dont_know_rate: float = 0.0,
+                 feature_quality: float = 1.0, answer_delay: float = 0.0, clock=None):
+        for name, value in (("mislabel rate", mislabel_rate), ("don't-know rate", dont_know_rate),
+                            ("feature quality", feature_quality)):
+            if not 0.0 <= float(value) <= 1.0:
+                raise ValueError(f"{name} must be between 0 and 1, got {value}")
+        if answer_delay < 0:
+            raise ValueError(f"answer delay must be zero or more seconds, got {answer_delay}")
         self.rng = rng
+        self.mislabel_rate, self.dont_know_rate = float(mislabel_rate), float(dont_know_rate)
+        self.feature_quality, self.answer_delay = float(feature_quality), float(answer_delay)
+        self.clock = clock or VirtualClock()
+        self.heard: list[str] = []
+        self.mislabels = 0
 
-    def answer(self, action: Action, question: str, scene: Scene) -> Answer:
-        if action.kind == "label":
-            concept = scene.truth.concepts[action.object_index]
-            return Answer(f"a {concept}", concept)
-        if action.kind == "demo":
-            members = [i for i, c in enumerate(scene.truth.concepts) if c == action.concept]
+    def options(self) -> dict:
+        return {"kind": "scripted", "mislabel_rate": self.mislabel_rate, "dont_know_rate": self.dont_know_rate,
+                "feature_quality": self.feature_quality, "answer_delay": self.answer_delay}
+
+    def show(self, prompt: Prompt) -> None:
+        pass
+
+    def tell(self, text: str) -> None:
+        self.heard.append(text)
+        del self.heard[:-20]
+
+    def listen(self, prompt: Prompt, deadline: float | None) -> str | None:
+        text, delay = self.compose(prompt)
+        self.clock.sleep(delay)
+        return text
+
+    def fast_forward(self, prompt: Prompt) -> None:
+        """Draw this question's answer without giving it (keeps the generator in step on resume)."""
+        self.compose(prompt)
+
+    def compose(self, prompt: Prompt) -> tuple[str, float]:
+        """The answer text and its delay; the generator is used in the same order every time."""
+        rng = self.rng
+        dont_know = rng.random() < self.dont_know_rate
+        wrong = rng.random() < self.mislabel_rate
+        delay = float(rng.gamma(DELAY_SHAPE, self.answer_delay / DELAY_SHAPE)) if self.answer_delay > 0 else 0.0
+        if dont_know:
+            return "I don't know", delay
+        truth = prompt.scene.truth
+        kind = prompt.action.kind
+        if kind == "label":
+            concept = truth.concepts[prompt.action.object_index]
+            if wrong and len(prompt.concepts) > 1:
+                others = [c for c in prompt.concepts if c != concept]
+                concept = others[int(rng.integers(len(others)))]
+                self.mislabels += 1
+            return article(concept), delay
+        if kind == "demo":
+            concept = prompt.action.concept
+            members = [i for i, c in enumerate(truth.concepts) if (c == concept) != wrong]
             if not members:
-                return Answer(f"there is no {action.concept} here", None)
-            index = int(members[self.rng.integers(len(members))])
-            return Answer(f"number {index + 1}", index)
-        raise ValueError(f"the oracle teacher cannot answer a '{action.kind}' question yet")
+                return f"there is no {concept} here", delay
+            if wrong:
+                self.mislabels += 1
+            return f"number {members[int(rng.integers(len(members)))] + 1}", delay
+        if kind == "feature":
+            return ", ".join(prompt.feature_tree.numbers_for(self._feature_choice(prompt))), delay
+        raise ValueError(f"a scripted teacher cannot answer a '{kind}' question")
+
+    def _feature_choice(self, prompt: Prompt) -> list[int]:
+        relevant = relevant_feature_indices(prompt)
+        everything = range(len(prompt.feature_tree.feature_names))
+        irrelevant = [i for i in everything if i not in set(relevant)]
+        keep = [i for i in relevant if self.rng.random() < self.feature_quality]
+        if not keep:
+            keep = [relevant[int(self.rng.integers(len(relevant)))]]
+        extra_rate = (1.0 - self.feature_quality) * len(relevant) / max(len(irrelevant), 1)
+        keep += [i for i in irrelevant if self.rng.random() < extra_rate]
+        return sorted(keep)
+
+
+class OracleTeacher(ScriptedTeacher):
+    """A perfect scripted teacher: always right, never unsure, answers at once."""
+
+    def __init__(self, rng: np.random.Generator, clock=None):
+        super().__init__(rng, clock=clock)
+
+
+class ReplayTeacher:
+    """Answers with the lines recorded in a transcript, turn by turn; None when a turn's lines run out."""
+
+    def __init__(self, records: list[dict]):
+        self.lines = {int(r["turn"]): list(r.get("answer", {}).get("lines", [])) for r in records}
+        self.heard: list[str] = []
+
+    def options(self) -> dict:
+        return {"kind": "replay"}
+
+    def show(self, prompt: Prompt) -> None:
+        pass
+
+    def tell(self, text: str) -> None:
+        self.heard.append(text)
+        del self.heard[:-20]
+
+    def listen(self, prompt: Prompt, deadline: float | None) -> str | None:
+        pending = self.lines.get(prompt.turn, [])
+        return pending.pop(0) if pending else None

@@ -2,6 +2,7 @@
 
 import json
 
+import numpy as np
 import pytest
 
 from dialog.manager import DialogManager, EpisodeConfig, episode_generators
@@ -102,3 +103,178 @@ def test_observers_see_every_scene_and_turn(tmp_path):
                       transcript, rngs, say=lambda _: None, observers=[recorder]).run()
     assert len(recorder.scenes) == 2 and [t for t, _ in recorder.turns] == [1, 2, 3, 4, 5, 6]
     assert recorder.turns[3][1] == recorder.scenes[1]
+
+
+# -- the full loop: every action kind, budget rules, real time, undo, resume ------------------------------------
+from dialog.clock import VirtualClock  # noqa: E402
+from dialog.teachers import ScriptedTeacher  # noqa: E402
+from dialog.transcript import read_session  # noqa: E402
+from learning.actions import DemoQuery, FeatureQuery, LabelQuery, NoQuery  # noqa: E402
+from tests.dialog.fakes import PantryEnvironment, ScriptedStrategy  # noqa: E402
+
+
+class LineTeacher:
+    """Answers every question with the next of the given lines; None (end of input) when they run out."""
+
+    def __init__(self, lines):
+        self.lines, self.heard = list(lines), []
+
+    def show(self, prompt):
+        pass
+
+    def listen(self, prompt, deadline):
+        return self.lines.pop(0) if self.lines else None
+
+    def tell(self, text):
+        self.heard.append(text)
+
+
+def manager_for(path, env, teacher, strategy, clock=None, **config):
+    config = EpisodeConfig(**config)
+    rngs = episode_generators(config.seed)
+    return DialogManager(env, teacher, strategy, config, TranscriptWriter(path), rngs, say=lambda _: None,
+                         clock=clock)
+
+
+def test_every_action_kind_is_realised_and_recorded(tmp_path):
+    actions = [FeatureQuery(), DemoQuery("fruit"), LabelQuery(1), NoQuery(), FeatureQuery(), DemoQuery("snack")]
+    teacher = LineTeacher(["colour", "ignore f3", "number 3", "a snack"])
+    manager = manager_for(tmp_path / "t.jsonl", FakeEnvironment(), teacher, ScriptedStrategy(actions), turns=6,
+                          budget=6, change_every=10)
+    result = manager.run()
+    header, records = read_session(tmp_path / "t.jsonl")
+    assert header["strategy"] == "scripted" and header["turns"] == 6 and header["format"] == "teachbot-transcript"
+    kinds = [r["action"]["kind"] for r in records]
+    assert kinds == ["feature", "demo", "label", "none", "none", "none"]
+    assert records[0]["answer"]["lines"] == ["colour", "ignore f3"] and records[0]["answer"]["parsed"] == ["f1", "f2"]
+    assert "I don't know 'colour'" in teacher.heard[0]
+    assert records[0]["model"]["features_in_use"] == 2 and manager.state.feature_subsets["fruit"].tolist() == [0, 1]
+    assert records[1]["answer"]["parsed"] == 3 and records[2]["answer"]["parsed"] == "snack"
+    assert records[4]["strategy_action"] == {"kind": "feature"}  # asked at most once
+    assert records[5]["strategy_action"] == {"kind": "demo", "concept": "snack"}  # budget 6 is spent
+    assert "budget is spent" in records[5]["explanation"]
+    for record in records:
+        assert {"turn", "time", "scene_id", "action", "answer", "cost", "budget_left", "model"} <= set(record)
+    assert [r["budget_left"] for r in records] == [4, 2, 1, 1, 1, 1]
+    assert result.queries == {"label": 1, "demo": 1, "feature": 1, "none": 3}
+
+
+def test_undo_takes_back_the_last_answer(tmp_path):
+    actions = [LabelQuery(0), LabelQuery(1), LabelQuery(2)]
+    teacher = LineTeacher(["a fruit", "undo", "undo", "a snack", "why", "beverage"])
+    manager = manager_for(tmp_path / "t.jsonl", FakeEnvironment(), teacher, ScriptedStrategy(actions), turns=3,
+                          budget=5)
+    manager.run()
+    records = read_session(tmp_path / "t.jsonl")[1]
+    assert records[1]["undid"] == [1] and records[1]["answer"]["lines"] == ["undo", "undo", "a snack"]
+    assert any("Taken back: number 1 is fruit (turn 1)" in h for h in teacher.heard)
+    assert any("nothing left to take back" in h for h in teacher.heard)
+    assert records[1]["model"]["examples"] == {"main dish": 0, "snack": 1, "fruit": 0, "beverage": 0}
+    assert [e.concept for e in manager.state.examples] == ["snack", "beverage"]
+    assert "Why I ask: step 3 of my script" in teacher.heard
+
+
+def test_quit_ends_the_session_without_recording_the_open_question(tmp_path):
+    teacher = LineTeacher(["a fruit", "quit"])
+    manager = manager_for(tmp_path / "t.jsonl", FakeEnvironment(), teacher,
+                          ScriptedStrategy([LabelQuery(0), LabelQuery(1)]), turns=5, budget=5)
+    result = manager.run()
+    assert result.quit and result.completed == 1 and len(read_transcript(tmp_path / "t.jsonl")) == 1
+
+
+def test_real_time_turns_and_late_answers(tmp_path):
+    clock = VirtualClock()
+    teacher = ScriptedTeacher(np.random.default_rng(0), answer_delay=6.0, clock=clock)
+    env = PantryEnvironment()
+    manager = manager_for(tmp_path / "t.jsonl", env, teacher, make_strategy("active"), clock=clock, turns=12,
+                          budget=20, change_every=3, realtime=8.0)
+    manager.run()
+    records = read_transcript(tmp_path / "t.jsonl")
+    late = [r for r in records if r["answer"]["kind"] == "late"]
+    on_time = [r for r in records if r["answer"]["kind"] == "answer"]
+    assert late and on_time  # gamma delays around 6 s: some beyond the 8 s turn
+    assert all(r["answer"]["seconds"] + 1.5 > 8.0 and r["answer"]["parsed"] is None for r in late)
+    assert all(r["time"] >= 8.0 * (r["turn"] - 1) - 1e-9 for r in records)  # a turn never starts before its slot
+    assert sum(manager.state.counts_per_concept().values()) == len(on_time)
+    for record in records:  # the world changes on its own clock: every 3 x 8 s
+        expected_epoch = int(record["time"] // 24.0)
+        assert record["scene_id"] - records[0]["scene_id"] <= expected_epoch
+
+
+def run_full(tmp_path, name, quit_at=None, resume_from=None):
+    config = EpisodeConfig(turns=14, budget=18, change_every=4, seed=5)
+    rngs = episode_generators(config.seed)
+    env = PantryEnvironment(missing=("fruit",))
+    inner = ScriptedTeacher(rngs["teacher"], mislabel_rate=0.2, dont_know_rate=0.1, answer_delay=2.0)
+
+    class Quitter:
+        def show(self, prompt):
+            pass
+
+        def listen(self, prompt, deadline):
+            return "quit" if prompt.turn == quit_at else inner.listen(prompt, deadline)
+
+        def tell(self, text):
+            pass
+
+        def fast_forward(self, prompt):
+            inner.fast_forward(prompt)
+
+    inner.clock = clock = VirtualClock()
+    actions = [FeatureQuery(), DemoQuery("fruit"), DemoQuery("snack")] + [LabelQuery(i % 8) for i in range(11)]
+    path = tmp_path / name
+    records = []
+    if resume_from is not None:
+        path = resume_from
+        records = read_session(path, tolerate_partial_tail=True)[1]
+    writer = TranscriptWriter(path, append=resume_from is not None)
+    manager = DialogManager(env, Quitter(), ScriptedStrategy(actions), config, writer, rngs, say=lambda _: None,
+                            clock=clock)
+    result = manager.run(replay=records)
+    writer.close()
+    return result, path, env
+
+
+def test_resume_after_quit_gives_the_same_transcript_as_an_unbroken_run(tmp_path):
+    _, whole, env = run_full(tmp_path, "whole.jsonl")
+    assert "fruit" in env.fetched  # the absent fruit came from the pantry
+    result, broken, _ = run_full(tmp_path, "broken.jsonl", quit_at=7)
+    assert result.quit and len(read_transcript(broken)) == 6
+    with open(broken, "a") as handle:
+        handle.write('{"turn": 7, "time": 3')  # a record cut short by a crash
+    resumed, _, _ = run_full(tmp_path, "unused", resume_from=broken)
+    assert resumed.completed == 14 and not resumed.quit
+    assert broken.read_bytes() == whole.read_bytes()
+
+
+def test_a_transcript_from_another_seed_is_refused(tmp_path):
+    _, whole, _ = run_full(tmp_path, "whole.jsonl")
+    lines = whole.read_text().splitlines()
+    record = json.loads(lines[3])
+    record["model"]["examples"]["fruit"] += 5
+    lines[3] = json.dumps(record)
+    whole.write_text("\n".join(lines[:4]) + "\n")
+    with pytest.raises(ValueError, match="turn 3: replaying the transcript gives"):
+        run_full(tmp_path, "unused", resume_from=whole)
+
+
+def test_observers_hear_questions_and_answers(tmp_path):
+    class Recorder:
+        def __init__(self):
+            self.events = []
+
+        def on_question(self, action, text, scene):
+            self.events.append(("question", action.kind, text[:8]))
+
+        def on_answer(self, action, outcome, scene):
+            self.events.append(("answer", action.kind, outcome.kind))
+
+    recorder = Recorder()
+    config = EpisodeConfig(turns=2, budget=5)
+    rngs = episode_generators(0)
+    with TranscriptWriter(tmp_path / "t.jsonl") as transcript:
+        DialogManager(FakeEnvironment(), LineTeacher(["a fruit", "none"]),
+                      ScriptedStrategy([LabelQuery(0), DemoQuery("fruit")]), config, transcript, rngs,
+                      say=lambda _: None, observers=[recorder]).run()
+    assert recorder.events == [("question", "label", "What is "), ("answer", "label", "answer"),
+                               ("question", "demo", "Can you "), ("answer", "demo", "absent")]

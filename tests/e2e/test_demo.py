@@ -5,6 +5,7 @@ import json
 import pytest
 
 from dialog.cli import main
+from dialog.transcript import read_transcript
 
 pytestmark = pytest.mark.e2e
 
@@ -22,9 +23,9 @@ def test_demo_runs_and_prints_a_json_summary(tmp_path, capsys):
                             "seconds"}
     assert summary["turns"] == 8 and summary["budget_spent"] <= 10
     assert set(summary["queries"]) == {"label", "demo", "none"} and sum(summary["queries"].values()) == 8
-    lines = (tmp_path / "run.jsonl").read_text().splitlines()
-    assert len(lines) == 8
-    gestures = [json.loads(line)["gesture"] for line in lines if "gesture" in json.loads(line)]
+    records = read_transcript(tmp_path / "run.jsonl")  # one record per turn after the session header
+    assert len(records) == 8 and len((tmp_path / "run.jsonl").read_text().splitlines()) == 9
+    gestures = [record["gesture"] for record in records if "gesture" in record]
     assert gestures and all(g["reached"] and g["horizontal_error_m"] < 0.02 for g in gestures)
 
 

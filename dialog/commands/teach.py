@@ -1,0 +1,160 @@
+"""``teachbot teach``: teach the robot at the terminal (or let a scripted teacher do it), resumable."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+from dialog.commands._arguments import add_episode_options, budget
+from dialog.environment import SimulatedKitchen
+from dialog.session import SessionSettings, open_session
+from dialog.transcript import read_session
+from learning.strategies import STRATEGY_NAMES
+
+PREFERRED_STRATEGIES = ("dt-task", "dt", "all-cd", "active")
+DEFAULT_STRATEGY = next(name for name in (*PREFERRED_STRATEGIES, STRATEGY_NAMES[0]) if name in STRATEGY_NAMES)
+
+
+def rate(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number between 0 and 1, got '{text}'") from None
+    if not 0.0 <= value <= 1.0:
+        raise argparse.ArgumentTypeError(f"expected a number between 0 and 1, got {value}")
+    return value
+
+
+def seconds(text: str) -> float:
+    value = budget(text)
+    if value <= 0:
+        raise argparse.ArgumentTypeError(f"expected a positive number of seconds, got {value}")
+    return value
+
+
+def register(commands) -> None:
+    parser = commands.add_parser(
+        "teach", help="teach the robot at the terminal: it points, asks, and learns from your answers",
+        description="Answer the robot's questions at the terminal. Type 'help' at any question for the accepted "
+                    "answers; 'quit' (or end of input) saves the session, which --resume continues.")
+    add_episode_options(parser, STRATEGY_NAMES, DEFAULT_STRATEGY)
+    parser.add_argument("--realtime", type=seconds, default=None, metavar="SECONDS",
+                        help="real-time mode: each turn lasts SECONDS; a later answer counts as none")
+    parser.add_argument("--transcript", type=Path, default=None,
+                        help="transcript path (default runs/teach-<task>-<strategy>-seed<seed>.jsonl, numbered "
+                             "if taken)")
+    parser.add_argument("--resume", type=Path, default=None, metavar="FILE",
+                        help="continue the session recorded in FILE with its own settings")
+    parser.add_argument("--teacher", choices=("terminal", "scripted", "replay"), default="terminal",
+                        help="who answers: you (terminal, default), a scripted oracle, or a recorded transcript")
+    parser.add_argument("--replay", type=Path, default=None, metavar="FILE",
+                        help="the transcript a replay teacher answers from")
+    parser.add_argument("--mislabel-rate", type=rate, default=0.0, help="scripted teacher: chance of a wrong label")
+    parser.add_argument("--dont-know-rate", type=rate, default=0.0,
+                        help="scripted teacher: chance of answering 'I don't know'")
+    parser.add_argument("--feature-quality", type=rate, default=1.0,
+                        help="scripted teacher: share of the relevant features named (1 = all, no noise)")
+    parser.add_argument("--answer-delay", type=budget, default=0.0, metavar="SECONDS",
+                        help="scripted teacher: mean seconds per answer")
+    parser.add_argument("--pictures", type=Path, default=None, metavar="DIR",
+                        help="folder for numbered scene pictures (default: next to the transcript for a person, "
+                             "none for a scripted teacher)")
+    parser.add_argument("--no-pictures", action="store_true", help="write no scene pictures")
+    parser.add_argument("--no-fetch", action="store_true",
+                        help="never fetch an absent example from the pantry")
+    parser.add_argument("--json", action="store_true", help="end with one JSON line summarising the session")
+    parser.set_defaults(handler=run)
+
+
+def _default_transcript(args) -> Path:
+    base = Path("runs") / f"teach-{args.task}-{args.strategy}-seed{args.seed}"
+    path, number = base.with_suffix(".jsonl"), 2
+    while path.exists():
+        path, number = Path(f"{base}-{number}.jsonl"), number + 1
+    return path
+
+
+def _settings(args) -> SessionSettings:
+    teacher = {"kind": args.teacher}
+    if args.teacher == "scripted":
+        teacher.update(mislabel_rate=args.mislabel_rate, dont_know_rate=args.dont_know_rate,
+                       feature_quality=args.feature_quality, answer_delay=args.answer_delay)
+    if args.teacher == "replay":
+        if args.replay is None:
+            raise ValueError("--teacher replay needs --replay FILE (a transcript to answer from)")
+        teacher["transcript"] = str(args.replay)
+    return SessionSettings(task=args.task, kitchen=args.kitchen, strategy=args.strategy, seed=args.seed,
+                           turns=args.turns, budget=args.budget, change_every=args.change_every,
+                           realtime=args.realtime, fetch_from_pantry=not args.no_fetch, teacher=teacher)
+
+
+def run(args: argparse.Namespace, input_stream=None, output_stream=None) -> int:
+    if args.resume is not None:
+        if not args.resume.exists():
+            raise FileNotFoundError(f"no transcript at {args.resume} to resume")
+        settings = SessionSettings.from_header(read_session(args.resume, tolerate_partial_tail=True)[0], args.resume)
+        path = args.resume
+    else:
+        settings = _settings(args)
+        path = args.transcript or _default_transcript(args)
+        if path.exists() and path.stat().st_size > 0:
+            raise ValueError(f"{path} already holds a session; continue it with --resume {path} or choose another "
+                             "--transcript")
+    person = settings.teacher["kind"] == "terminal"
+    pictures = None
+    if not args.no_pictures:
+        pictures = args.pictures or (path.parent / f"{path.stem}-pictures" if person else None)
+    out = output_stream or sys.stdout
+    environment = SimulatedKitchen(task=settings.task, kitchen=settings.kitchen, seed=settings.seed,
+                                   pictures=pictures is not None)
+    try:
+        manager, records = open_session(settings, environment, path, resume=args.resume is not None,
+                                        pictures=None if pictures is None else str(pictures),
+                                        input_stream=input_stream, output_stream=out, say=None)
+        manager.say = _narrator(manager.teacher, out, person)
+        intro = (f"Teaching '{settings.task}' ({', '.join(environment.concepts)}) in {settings.kitchen}: "
+                 f"{settings.turns} turns, budget {settings.budget:g}, strategy {settings.strategy}. "
+                 f"Transcript: {path}")
+        if records:
+            intro += f" (resuming after turn {len(records)})"
+        manager.say(intro)
+        if person:
+            manager.say("Type 'help' at any question for what you can answer; 'quit' saves and stops.")
+        try:
+            result = manager.run(replay=records)
+        except KeyboardInterrupt:
+            manager.say(f"\nInterrupted. The session is saved; continue it with: teachbot teach --resume {path}")
+            return 130
+        finally:
+            manager.transcript.close()
+    finally:
+        environment.close()
+    if manager.replay_mismatches:
+        manager.say(f"(note: on {manager.replay_mismatches} replayed turn(s) the strategy would now ask something "
+                    "else; the recorded questions were kept)")
+    if result.quit:
+        manager.say(f"Session saved after {result.completed} of {result.turns} turns. Continue it with: "
+                    f"teachbot teach --resume {path}")
+    manager.say(f"Accuracy on {settings.task} held-out scenes: {result.accuracy:.1%} (chance "
+                f"{1 / len(environment.concepts):.0%}); budget spent {result.budget_spent:g} of {settings.budget:g}; "
+                f"queries {result.queries}; {result.seconds:.1f} s.")
+    if args.json:
+        print(json.dumps({"seed": result.seed, "strategy": result.strategy, "turns": result.turns,
+                          "completed": result.completed, "quit": result.quit, "budget_spent": result.budget_spent,
+                          "queries": result.queries, "accuracy": round(result.accuracy, 6),
+                          "transcript": str(path), "seconds": round(result.seconds, 3)}), file=out, flush=True)
+    return 0
+
+
+def _narrator(teacher, out, person: bool):
+    """Progress lines: everything for a scripted run; scene changes and quiet turns for a person."""
+    def say(text: str) -> None:
+        if person and text.startswith("Turn") and "stays quiet" not in text and "ended the session" not in text:
+            return
+        if hasattr(teacher, "say"):
+            teacher.say(text)
+        else:
+            print(text, file=out, flush=True)
+    return say

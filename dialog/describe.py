@@ -1,0 +1,157 @@
+"""Plain-language descriptions of scene objects: "the red round thing near the fridge, number 4".
+
+Everything here comes from what the robot perceived (mean colour, measured
+size, perceived position) and the kitchen's semantic locations, never from the
+hidden ground truth.
+"""
+
+from __future__ import annotations
+
+try:
+    import tomllib
+except ModuleNotFoundError:  # Python 3.10
+    import tomli as tomllib
+import colorsys
+from functools import lru_cache
+from pathlib import Path
+
+import numpy as np
+
+COLOURS_FILE = Path(__file__).parent / "data" / "colours.toml"
+SIZE_FEATURES = {"length": ("size.length", "bbox.length", "length"), "width": ("size.width", "bbox.width", "width"),
+                 "height": ("size.height", "bbox.height", "height")}
+ROUND_ASPECT = 1.2      # length / width at most this: round (or square) from above
+LONG_ASPECT = 1.7       # at least this: long
+FLAT_RATIO = 0.45       # height / width at most this: flat
+TALL_RATIO = 1.4        # height / length at least this: tall
+NEAR_METRES = 0.2       # farther from every location: the area of the counter ("at the front left")
+SURFACES = ("counter", "table", "worktop")
+
+
+@lru_cache(maxsize=2)
+def colour_table(path: str | Path = COLOURS_FILE) -> dict:
+    with open(path, "rb") as handle:
+        table = tomllib.load(handle)
+    for key in ("grey_saturation", "grey", "hue"):
+        if key not in table:
+            raise ValueError(f"{path}: missing '{key}'")
+    return table
+
+
+def colour_name(rgb) -> str:
+    """A colour word for a perceived mean colour (RGB in 0..1), by hue bands in ``colours.toml``."""
+    red, green, blue = (float(np.clip(c, 0.0, 1.0)) for c in rgb)
+    hue, saturation, value = colorsys.rgb_to_hsv(red, green, blue)
+    hue *= 360.0
+    table = colour_table()
+    if saturation < table["grey_saturation"] or value < 0.12:
+        for grey in table["grey"]:
+            if value < grey["below_value"]:
+                return grey["name"]
+        return table["grey"][-1]["name"]
+    for band in table["hue"]:
+        if band["from"] <= hue < band["to"] or (hue == 360.0 and band["to"] == 360.0):
+            if "dark_name" in band and value < band["dark_value"]:
+                return band["dark_name"]
+            if "pale_name" in band and saturation < band["pale_saturation"]:
+                return band["pale_name"]
+            return band["name"]
+    return "coloured"
+
+
+def shape_words(length: float, width: float, height: float) -> list[str]:
+    """Shape cues from the measured size: round, long, flat, tall."""
+    long_side, short_side = max(length, width), max(min(length, width), 1e-6)
+    cues = []
+    aspect = long_side / short_side
+    if aspect <= ROUND_ASPECT:
+        cues.append("round" if abs(length - width) / long_side < 0.12 else "squarish")
+    elif aspect >= LONG_ASPECT:
+        cues.append("long")
+    if height / short_side <= FLAT_RATIO:
+        cues.append("flat")
+    elif height / long_side >= TALL_RATIO:
+        cues.append("tall")
+    return cues
+
+
+def area_phrase(xy) -> str:
+    """Where on the counter, as the robot (and a person behind it) sees it: front is near the robot."""
+    x, y = float(xy[0]), float(xy[1])
+    depth = "front" if y < -0.08 else "back" if y > 0.12 else "middle"
+    side = "left" if x < -0.12 else "right" if x > 0.12 else ""
+    if depth == "middle":
+        return f"on the {side}" if side else "in the middle"
+    return f"at the {depth} {side}".rstrip() if side else f"at the {depth}"
+
+
+def place_phrase(xy, locations: dict) -> str:
+    """"at the stove" inside a location's region, "near the fridge" close to one, else the area of the counter.
+
+    Work surfaces (the counter itself) hold everything, so they name no place.
+    """
+    xy = np.asarray(xy, dtype=float)[:2]
+    places = {name: loc for name, loc in (locations or {}).items() if name not in SURFACES}
+    for name, location in places.items():
+        contains = getattr(location, "contains", None)
+        if contains is not None and contains(xy):
+            return f"at the {name}"
+    if places:
+        centres = {name: np.asarray(getattr(loc, "centre", loc), dtype=float)[:2] for name, loc in places.items()}
+        name, distance = min(((n, float(np.linalg.norm(xy - c))) for n, c in centres.items()), key=lambda p: p[1])
+        if distance <= NEAR_METRES:
+            return f"near the {name}"
+    return area_phrase(xy)
+
+
+def _column(scene, candidates) -> np.ndarray | None:
+    for name in candidates:
+        if name in scene.feature_names:
+            return scene.feature(name)
+    return None
+
+
+class SceneDescriber:
+    """Descriptions and a short table of one scene's objects, numbered from 1."""
+
+    def __init__(self, scene, locations: dict | None = None):
+        self.scene = scene
+        self.locations = locations or {}
+        n = scene.n_objects
+        sizes = [_column(scene, SIZE_FEATURES[k]) for k in ("length", "width", "height")]
+        self.sizes = np.column_stack(sizes) if all(s is not None for s in sizes) else None
+        self.colours = np.asarray(scene.colours, dtype=float).reshape(n, -1) if n else np.zeros((0, 3))
+        has_colour = self.colours.shape[1] == 3 and np.any(self.colours > 0)
+        self.colour_names = [colour_name(c) if has_colour else "" for c in self.colours]
+        positions = np.asarray(scene.positions, dtype=float).reshape(n, -1) if n else np.zeros((0, 3))
+        placed = positions.shape[1] >= 2 and bool(np.any(positions[:, :2] != 0))
+        self.places = [place_phrase(p, self.locations) if placed else "" for p in positions]
+        volumes = np.prod(self.sizes, axis=1) if self.sizes is not None else np.zeros(0)
+        if n >= 3 and len(volumes) and np.ptp(volumes) > 0:  # small and big only compared with the rest
+            low, high = np.quantile(volumes, [0.25, 0.75])
+            self.size_words = ["small" if v <= low else "big" if v >= high else "" for v in volumes]
+        else:
+            self.size_words = [""] * n
+
+    def describe(self, index: int) -> str:
+        """"the big red round thing near the fridge" (as much as the robot perceives)."""
+        words = [self.size_words[index], self.colour_names[index]]
+        if self.sizes is not None:
+            words += shape_words(*self.sizes[index])
+        words = [w for w in words if w]
+        text = "the " + " ".join([*words, "thing"]) if words else "the object"
+        if self.places[index]:
+            text += " " + self.places[index]
+        return text
+
+    def table_lines(self, only=None) -> list[str]:
+        """A short table: number, colour, size in centimetres, place (all objects, or the indices ``only``)."""
+        header = f"{'no.':>3}  {'colour':<11} {'size (cm)':<15} place"
+        lines = [header]
+        for index in (range(self.scene.n_objects) if only is None else only):
+            size = ("x".join(f"{v * 100:.0f}" for v in self.sizes[index]) if self.sizes is not None else "?")
+            if self.size_words[index]:
+                size = f"{size} {self.size_words[index]}"
+            lines.append(f"{index + 1:>3}  {self.colour_names[index] or '?':<11} {size:<15} "
+                         f"{self.places[index] or '?'}")
+        return lines

@@ -1,0 +1,52 @@
+"""Numbered scene pictures: the camera image with each object's number drawn at its perceived position."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+RING_BGR = (0, 215, 255)     # the object the robot asks about
+LABEL_BGR = (255, 255, 255)
+OUTLINE_BGR = (0, 0, 0)
+
+
+def project_points(points, view_matrix, projection_matrix, width: int, height: int) -> np.ndarray:
+    """Pixel (column, row) of world points through OpenGL-style 4x4 view and projection matrices."""
+    points = np.asarray(points, dtype=float).reshape(-1, 3)
+    homogeneous = np.hstack([points, np.ones((len(points), 1))])
+    clip = (np.asarray(projection_matrix) @ np.asarray(view_matrix) @ homogeneous.T).T
+    ndc = clip[:, :3] / clip[:, 3:4]
+    columns = (ndc[:, 0] + 1.0) * 0.5 * width
+    rows = (1.0 - ndc[:, 1]) * 0.5 * height
+    return np.column_stack([columns, rows])
+
+
+def annotate_scene(rgb: np.ndarray, pixels, numbers, highlight: int | None = None) -> np.ndarray:
+    """A BGR copy of ``rgb`` with ``numbers[i]`` written at ``pixels[i]``; ``highlight`` (an index) is ringed."""
+    image = cv2.cvtColor(np.ascontiguousarray(rgb, dtype=np.uint8), cv2.COLOR_RGB2BGR)
+    height, width = image.shape[:2]
+    scale = max(0.45, width / 900.0)
+    for index, ((column, row), number) in enumerate(zip(np.asarray(pixels, dtype=float), numbers)):
+        if not (np.isfinite(column) and np.isfinite(row)):
+            continue
+        centre = (int(round(np.clip(column, 0, width - 1))), int(round(np.clip(row, 0, height - 1))))
+        if index == highlight:
+            cv2.circle(image, centre, int(22 * scale / 0.7), RING_BGR, 3, cv2.LINE_AA)
+        text = str(number)
+        (text_w, text_h), _ = cv2.getTextSize(text, cv2.FONT_HERSHEY_SIMPLEX, scale, 2)
+        origin = (centre[0] - text_w // 2, centre[1] + text_h // 2)
+        cv2.putText(image, text, origin, cv2.FONT_HERSHEY_SIMPLEX, scale, OUTLINE_BGR, 4, cv2.LINE_AA)
+        cv2.putText(image, text, origin, cv2.FONT_HERSHEY_SIMPLEX, scale,
+                    RING_BGR if index == highlight else LABEL_BGR, 2, cv2.LINE_AA)
+    return image
+
+
+def save_picture(path: str | Path, bgr: np.ndarray) -> Path:
+    """Write a BGR image as PNG; the folder is created."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    if not cv2.imwrite(str(path), bgr, [cv2.IMWRITE_PNG_COMPRESSION, 3]):
+        raise RuntimeError(f"could not write the scene picture {path}")
+    return path
