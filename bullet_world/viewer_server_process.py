@@ -1,0 +1,61 @@
+"""The meshcat server of the viewer, run as a child process: web page and ZeroMQ on 127.0.0.1 only.
+
+meshcat's own server binds its ZeroMQ socket to 127.0.0.1 but lets tornado
+serve the web page on every interface; here tornado listens on the loopback
+address too. Run as a script (``python viewer_server_process.py``), it prints
+``zmq_url=...`` and ``web_url=...`` for the parent and serves until stopped.
+It imports only tornado, ZeroMQ and meshcat's server module: meshcat's package
+``__init__`` (numpy, IPython, PIL) is skipped, which halves the start-up time.
+"""
+
+import importlib.util
+import sys
+import types
+
+LOOPBACK = "127.0.0.1"
+
+
+def _server_module():
+    """meshcat.servers.zmqserver without running meshcat/__init__.py (the server needs none of it)."""
+    if "meshcat" not in sys.modules:
+        spec = importlib.util.find_spec("meshcat")
+        package = types.ModuleType("meshcat")
+        package.__path__ = list(spec.submodule_search_locations)
+        sys.modules["meshcat"] = package
+    import meshcat.servers.zmqserver as server
+
+    return server
+
+
+def bridge_class():
+    import tornado.web
+
+    server = _server_module()
+
+    class LoopbackApplication(tornado.web.Application):
+        def listen(self, port, address="", **kwargs):  # the address is forced to the loopback one
+            return super().listen(port, address=LOOPBACK, **kwargs)
+
+    class LoopbackBridge(server.ZMQWebSocketBridge):
+        def make_app(self):
+            return LoopbackApplication([
+                (r"/static/(.*)", server.StaticFileHandlerNoCache,
+                 {"path": server.VIEWER_ROOT, "default_filename": "index.html"}),
+                (r"/", server.WebSocketHandler, {"bridge": self}),
+            ])
+
+    return LoopbackBridge
+
+
+def main() -> None:
+    bridge = bridge_class()(host=LOOPBACK)
+    print(f"zmq_url={bridge.zmq_url}", flush=True)
+    print(f"web_url={bridge.web_url}", flush=True)
+    try:
+        bridge.run()
+    except KeyboardInterrupt:
+        pass
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,73 @@
+"""``--viewer`` and ``--viewer-export`` for every command that runs the simulated kitchen.
+
+Wiring, in a command module::
+
+    add_viewer_option(parser)                                   # in register()
+    with viewer_observers(args, environment.world) as observers:  # in run()
+        manager = DialogManager(..., observers=observers)
+        result = manager.run()
+
+If the viewer can't start, one warning line goes to standard error and the
+session goes on headless.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from contextlib import contextmanager
+from pathlib import Path
+
+
+def add_viewer_option(parser: argparse.ArgumentParser) -> None:
+    """Add ``--viewer`` (live meshcat mirror) and ``--viewer-export HTML`` (the episode as one page)."""
+    group = parser.add_argument_group("viewer")
+    group.add_argument("--viewer", action="store_true",
+                       help="show the kitchen live in meshcat (the URL is printed; it listens on 127.0.0.1 only)")
+    group.add_argument("--viewer-export", type=Path, default=None, metavar="HTML",
+                       help="write the episode as one static HTML page with meshcat's animation (opens without "
+                            "a server)")
+
+
+def start_viewer(args: argparse.Namespace, world):
+    """The viewer the options ask for, or None (nothing asked, or it could not start: one warning line)."""
+    live = bool(getattr(args, "viewer", False))
+    export = getattr(args, "viewer_export", None)
+    if not live and export is None:
+        return None
+    try:
+        from bullet_world.viewer import Viewer
+
+        viewer = Viewer(world, live=live, export_path=export)
+    except Exception as error:  # any failure to start leaves the session headless
+        print(f"warning: the viewer did not start ({type(error).__name__}: {error}); going on without it",
+              file=sys.stderr)
+        return None
+    if viewer.url:
+        print(f"Viewer: {viewer.url}", file=sys.stderr)
+    return viewer
+
+
+def stop_viewer(viewer) -> dict | None:
+    """Close the viewer (writing its export, if asked for); a failure is a warning, never an error."""
+    if viewer is None:
+        return None
+    try:
+        written = viewer.close()
+    except Exception as error:  # the session's own results matter more than the picture of it
+        print(f"warning: the viewer did not close cleanly ({type(error).__name__}: {error})", file=sys.stderr)
+        return None
+    if written:
+        print(f"Episode page: {written['path']} ({written['bytes'] / 1e6:.1f} MB, "
+              f"{written['seconds']:.0f} s of animation)", file=sys.stderr)
+    return written
+
+
+@contextmanager
+def viewer_observers(args: argparse.Namespace, world):
+    """Dialog observers for the options: ``(viewer,)`` or ``()``; the viewer is closed on the way out."""
+    viewer = start_viewer(args, world)
+    try:
+        yield (viewer,) if viewer is not None else ()
+    finally:
+        stop_viewer(viewer)

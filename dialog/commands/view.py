@@ -1,0 +1,97 @@
+"""``teachbot view``: open one scene of the kitchen in meshcat and print the URL.
+
+The scene is the first one ``teachbot demo`` would show for the same task,
+kitchen and seed. ``--point N`` makes the arm point at object N the way a
+label question does (highlight, question text); ``--export`` writes the
+scene (and the pointing motion) as one static HTML page; ``--screenshot``
+saves a PNG through headless Chromium.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+from dialog.commands._arguments import positive_int
+
+
+def seconds(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number of seconds, got '{text}'") from None
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"expected zero or more seconds, got {value:g}")
+    return value
+
+
+def register(commands) -> None:
+    parser = commands.add_parser("view", help="show one scene of the kitchen in meshcat (a browser) and print the URL")
+    parser.add_argument("--task", default="pack-lunchbox", help="task data file name (default pack-lunchbox)")
+    parser.add_argument("--kitchen", default="kitchen-1", help="kitchen data file name (default kitchen-1)")
+    parser.add_argument("--seed", type=int, default=0, help="seed of the scene (default 0)")
+    parser.add_argument("--point", type=positive_int, default=None, metavar="N",
+                        help="let the arm point at object N and ask about it, as a label question does")
+    parser.add_argument("--export", type=Path, default=None, metavar="HTML",
+                        help="write the scene as one static HTML page (opens without a server)")
+    parser.add_argument("--screenshot", type=Path, default=None, metavar="PNG",
+                        help="save a picture of the page through headless Chromium (needs chromium and playwright)")
+    parser.add_argument("--seconds", type=seconds, default=None,
+                        help="keep serving this long, then exit (default: until Ctrl-C; 0: exit at once)")
+    parser.set_defaults(handler=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from bullet_world.viewer import Viewer
+    from dialog.environment import SimulatedKitchen
+    from dialog.manager import episode_generators
+
+    environment = SimulatedKitchen(task=args.task, kitchen=args.kitchen, seed=args.seed)
+    try:
+        scene = environment.next_scene(episode_generators(args.seed)["scenes"])
+        if args.point is not None and args.point > scene.n_objects:
+            raise ValueError(f"--point {args.point}: the scene has objects 1 to {scene.n_objects}")
+        viewer = Viewer(environment.world, record=args.export is not None)
+        try:
+            viewer.start_recording()
+            viewer.on_scene(scene)
+            if args.point is not None:
+                action = {"kind": "label", "object": args.point}
+                gesture = environment.point_at(scene, args.point - 1)
+                viewer.on_question(action, f"What is this (object {args.point})?", scene)
+                print(f"The arm points at object {args.point} (fingertip {gesture['horizontal_error_m'] * 100:.1f} cm "
+                      f"from its centre, {gesture['sim_seconds']:.2f} s of simulated motion).")
+            print(f"Scene {scene.scene_id} of {args.task} in {args.kitchen} (seed {args.seed}): "
+                  f"{scene.n_objects} objects, numbered 1 to {scene.n_objects}.")
+            print(f"Viewer: {viewer.url}")
+            if args.export is not None:
+                written = viewer.export_html(args.export, title=f"teachbot {args.task} seed {args.seed}")
+                print(f"Page: {written['path']} ({written['bytes'] / 1e6:.1f} MB)")
+            if args.screenshot is not None:
+                from bullet_world.viewer_snapshot import screenshot
+
+                shot = screenshot(viewer.url, args.screenshot, min_drawn=scene.n_objects + 2)
+                print(f"Picture: {shot['path']} ({shot['drawn']} meshes and labels drawn)")
+            _serve(args.seconds)
+        finally:
+            viewer.close()
+    finally:
+        environment.close()
+    return 0
+
+
+def _serve(duration: float | None) -> None:
+    if duration == 0:
+        return
+    print("Serving; press Ctrl-C to stop." if duration is None else f"Serving for {duration:g} s.", flush=True)
+    try:
+        time.sleep(duration) if duration is not None else _forever()
+    except KeyboardInterrupt:
+        print("", file=sys.stderr)
+
+
+def _forever() -> None:
+    while True:
+        time.sleep(3600)
