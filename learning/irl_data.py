@@ -1,0 +1,370 @@
+"""Expert questioning demonstrations as plain arrays, for inverse RL (thesis §7.3.2).
+
+A questioning episode is a sequence of turns. At turn t the learner faces the
+candidate actions A_t (|Y| demo queries, |X| label queries, the feature-subset
+query, no query) and, for each candidate a, the decision-feature vector it
+expects after taking it,
+
+    Phi_t[a] = sum_{s'} P(s' | a, s_t) phi(s')          (thesis eq. 7.1, 7.2)
+
+so that EU(a | s_t) = w . Phi_t[a] for the linear utility U(s) = w . phi(s).
+The no-query action leaves the state unchanged: its row is phi(s_t). The
+expert's choice is the index of one row. Nothing here knows about the
+simulator or the dialog: whoever records an episode fills these arrays.
+
+Files (no pickle): JSON (readable, for a few episodes) or NPZ (compact). Both
+hold a list of episodes that share one tuple of feature names.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from learning.actions import DEFAULT_COSTS
+
+FORMAT_NAME = "teachbot-irl-demonstrations"
+FORMAT_VERSION = 1
+ACTION_KINDS: tuple[str, ...] = tuple(DEFAULT_COSTS)  # label, demo, feature, none
+NO_QUERY_KIND = "none"
+FEATURE_NAME_PATTERN = re.compile(r"^[A-Za-z][A-Za-z0-9_-]*$")
+ACCEPTED_SUFFIXES = (".json", ".npz")
+
+
+def check_feature_names(names: Sequence[str], source: str = "feature names") -> tuple[str, ...]:
+    """Decision-feature names: non-empty, distinct, letters/digits/_/- starting with a letter (TOML bare keys)."""
+    if isinstance(names, str) or not isinstance(names, Sequence) or len(names) == 0:
+        raise ValueError(f"{source}: expected a non-empty list of decision-feature names, got {names!r}")
+    names = tuple(names)
+    for name in names:
+        if not isinstance(name, str) or not FEATURE_NAME_PATTERN.match(name):
+            raise ValueError(f"{source}: feature name {name!r} is not accepted; use letters, digits, '_' or '-', "
+                             "starting with a letter")
+    if len(set(names)) != len(names):
+        duplicates = sorted({n for n in names if names.count(n) > 1})
+        raise ValueError(f"{source}: feature names must be distinct; repeated: {', '.join(duplicates)}")
+    return names
+
+
+def _optional_strings(values, n_actions: int, what: str) -> tuple[str, ...] | None:
+    if values is None:
+        return None
+    if isinstance(values, str) or not isinstance(values, Sequence | np.ndarray):
+        raise ValueError(f"action {what} must be a list of {n_actions} strings, got {type(values).__name__}")
+    values = tuple(values)
+    if len(values) != n_actions or not all(isinstance(v, str) for v in values):
+        raise ValueError(f"action {what} must be a list of {n_actions} strings (one per candidate action), "
+                         f"got {len(values)} entries")
+    return values
+
+
+@dataclass(frozen=True, eq=False)
+class DecisionTurn:
+    """One turn: candidate features Phi (n_actions x k), the expert's choice, optional kinds and labels."""
+
+    phi: np.ndarray
+    chosen: int
+    kinds: tuple[str, ...] | None = None
+    labels: tuple[str, ...] | None = None
+
+    def __post_init__(self) -> None:
+        try:
+            phi = np.array(self.phi, dtype=np.float64)
+        except (TypeError, ValueError):
+            raise ValueError("turn features Phi must be a numeric (n_actions x k) matrix") from None
+        if phi.ndim != 2 or phi.shape[0] < 1 or phi.shape[1] < 1:
+            raise ValueError(f"turn features Phi must be a 2-D (n_actions x k) matrix with at least one action "
+                             f"and one feature, got shape {phi.shape}")
+        if not np.all(np.isfinite(phi)):
+            raise ValueError("turn features Phi must be finite numbers (no NaN or infinity)")
+        phi.setflags(write=False)
+        object.__setattr__(self, "phi", phi)
+        chosen = self.chosen
+        if isinstance(chosen, bool) or not isinstance(chosen, int | np.integer) or not 0 <= chosen < phi.shape[0]:
+            raise ValueError(f"chosen action must be an integer index in 0..{phi.shape[0] - 1}, got {chosen!r}")
+        object.__setattr__(self, "chosen", int(chosen))
+        kinds = _optional_strings(self.kinds, phi.shape[0], "kinds")
+        if kinds is not None:
+            unknown = sorted(set(kinds) - set(ACTION_KINDS))
+            if unknown:
+                raise ValueError(f"unknown action kind {unknown[0]!r}; accepted: {', '.join(ACTION_KINDS)}")
+            if kinds.count(NO_QUERY_KIND) > 1:
+                raise ValueError("a turn has at most one no-query ('none') action")
+        object.__setattr__(self, "kinds", kinds)
+        object.__setattr__(self, "labels", _optional_strings(self.labels, phi.shape[0], "labels"))
+
+    @property
+    def n_actions(self) -> int:
+        return self.phi.shape[0]
+
+    @property
+    def no_query_index(self) -> int | None:
+        """Index of the no-query action, if the action kinds are known and include it."""
+        if self.kinds is None or NO_QUERY_KIND not in self.kinds:
+            return None
+        return self.kinds.index(NO_QUERY_KIND)
+
+    def utilities(self, weights: np.ndarray) -> np.ndarray:
+        """EU(a | s_t) = w . Phi_t[a] for every candidate (thesis eq. 7.1, 7.2)."""
+        return self.phi @ np.asarray(weights, dtype=np.float64)
+
+
+def turn_with_no_query(state_phi, query_phi, chosen: int | None, query_kinds=None,
+                       query_labels=None) -> DecisionTurn:
+    """A turn whose last candidate is no query, with phi(s) as its row; ``chosen=None`` means the expert kept quiet.
+
+    With NQ's value U(s) among the candidates, argmax over all of them is the DT
+    rule "take a* only if EU(a*) > U(s)" (thesis §6, §7.3.1), ties going to NQ.
+    """
+    state_phi = np.asarray(state_phi, dtype=np.float64)
+    query_phi = np.asarray(query_phi, dtype=np.float64)
+    if state_phi.ndim != 1:
+        raise ValueError(f"state features phi(s) must be a vector, got shape {state_phi.shape}")
+    if query_phi.ndim != 2 or query_phi.shape[1] != state_phi.shape[0]:
+        raise ValueError(f"query features must be a (n_queries x {state_phi.shape[0]}) matrix, "
+                         f"got shape {query_phi.shape}")
+    n_queries = query_phi.shape[0]
+    if chosen is not None and (isinstance(chosen, bool) or not isinstance(chosen, int | np.integer)
+                               or not 0 <= chosen < n_queries):
+        raise ValueError(f"chosen query must be None (no query) or an index in 0..{n_queries - 1}, got {chosen!r}")
+    kinds = None
+    if query_kinds is not None:
+        kinds = (*_optional_strings(query_kinds, n_queries, "kinds"), NO_QUERY_KIND)
+    labels = None
+    if query_labels is not None:
+        labels = (*_optional_strings(query_labels, n_queries, "labels"), "no query")
+    return DecisionTurn(np.vstack([query_phi, state_phi[None, :]]), n_queries if chosen is None else int(chosen),
+                        kinds, labels)
+
+
+@dataclass(frozen=True, eq=False)
+class QuestioningEpisode:
+    """One expert (or learner) questioning episode: named decision features and its turns in order."""
+
+    feature_names: tuple[str, ...]
+    turns: tuple[DecisionTurn, ...]
+    name: str = ""
+    metadata: dict = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        names = check_feature_names(self.feature_names, f"episode {self.name!r}")
+        object.__setattr__(self, "feature_names", names)
+        turns = tuple(self.turns)
+        if not turns:
+            raise ValueError(f"episode {self.name!r} has no turns; an episode needs at least one")
+        for t, turn in enumerate(turns):
+            if not isinstance(turn, DecisionTurn):
+                raise ValueError(f"episode {self.name!r}, turn {t}: expected a DecisionTurn, got {type(turn).__name__}")
+            if turn.phi.shape[1] != len(names):
+                raise ValueError(f"episode {self.name!r}, turn {t}: Phi has {turn.phi.shape[1]} feature columns, "
+                                 f"but the episode names {len(names)} features")
+        object.__setattr__(self, "turns", turns)
+        if not isinstance(self.name, str):
+            raise ValueError(f"episode name must be a string, got {type(self.name).__name__}")
+        if not isinstance(self.metadata, dict):
+            raise ValueError(f"episode {self.name!r}: metadata must be a table (dict), "
+                             f"got {type(self.metadata).__name__}")
+        try:
+            metadata = json.loads(json.dumps(self.metadata, allow_nan=False))
+        except (TypeError, ValueError):
+            raise ValueError(f"episode {self.name!r}: metadata must be a JSON-compatible table "
+                             "(strings, finite numbers, booleans, lists, tables)") from None
+        object.__setattr__(self, "metadata", metadata)
+
+    def feature_counts(self) -> np.ndarray:
+        """phi_E(tau): the sum over turns of the chosen action's features (thesis §2.5.2, eq. 7.6)."""
+        return np.sum([turn.phi[turn.chosen] for turn in self.turns], axis=0)
+
+
+def common_feature_names(episodes: Sequence[QuestioningEpisode], what: str = "episodes") -> tuple[str, ...]:
+    """The one tuple of feature names every episode shares; a clear error otherwise."""
+    episodes = list(episodes)
+    if not episodes:
+        raise ValueError(f"no {what}: at least one questioning episode is needed")
+    for episode in episodes:
+        if not isinstance(episode, QuestioningEpisode):
+            raise ValueError(f"{what}: expected QuestioningEpisode objects, got {type(episode).__name__}")
+    names = episodes[0].feature_names
+    for episode in episodes[1:]:
+        if episode.feature_names != names:
+            raise ValueError(f"{what}: episode {episode.name!r} has features {list(episode.feature_names)}, "
+                             f"but episode {episodes[0].name!r} has {list(names)}; all must match")
+    return names
+
+
+# -- files ---------------------------------------------------------------------------------------------------------
+def save_episodes(path: str | Path, episodes: Sequence[QuestioningEpisode]) -> Path:
+    """Write episodes to ``.json`` or ``.npz`` (chosen by the suffix); returns the path."""
+    path = Path(path)
+    names = common_feature_names(episodes)
+    if path.suffix == ".json":
+        document = {"format": FORMAT_NAME, "version": FORMAT_VERSION, "feature_names": list(names),
+                    "episodes": [_episode_to_json(e) for e in episodes]}
+        path.write_text(json.dumps(document, indent=1, allow_nan=False) + "\n", encoding="utf-8")
+    elif path.suffix == ".npz":
+        np.savez_compressed(path, **_episodes_to_arrays(names, episodes))
+    else:
+        raise ValueError(f"{path}: unknown demonstration file type {path.suffix!r}; accepted: .json, .npz")
+    return path
+
+
+def load_episodes(path: str | Path) -> list[QuestioningEpisode]:
+    """Read a ``.json`` or ``.npz`` demonstration file; bad content raises a one-line ValueError naming the file."""
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"demonstration file {path} does not exist")
+    try:
+        if path.suffix == ".json":
+            return _episodes_from_json(path)
+        if path.suffix == ".npz":
+            return _episodes_from_npz(path)
+    except ValueError as error:
+        message = str(error)
+        raise ValueError(message if message.startswith(str(path)) else f"{path}: {message}") from None
+    raise ValueError(f"{path}: unknown demonstration file type {path.suffix!r}; accepted: .json, .npz")
+
+
+def load_episode_dir(directory: str | Path) -> list[QuestioningEpisode]:
+    """Every ``*.json`` and ``*.npz`` demonstration file in a directory, in name order; names must agree."""
+    directory = Path(directory)
+    if not directory.is_dir():
+        raise FileNotFoundError(f"demonstration directory {directory} does not exist")
+    files = sorted(p for p in directory.iterdir() if p.suffix in ACCEPTED_SUFFIXES and p.is_file())
+    if not files:
+        raise ValueError(f"{directory}: no demonstration files (*.json or *.npz) found")
+    episodes = [episode for file in files for episode in load_episodes(file)]
+    common_feature_names(episodes, f"demonstrations in {directory}")
+    return episodes
+
+
+def _episode_to_json(episode: QuestioningEpisode) -> dict:
+    turns = []
+    for turn in episode.turns:
+        record = {"chosen": turn.chosen, "phi": turn.phi.tolist()}
+        if turn.kinds is not None:
+            record["kinds"] = list(turn.kinds)
+        if turn.labels is not None:
+            record["labels"] = list(turn.labels)
+        turns.append(record)
+    return {"name": episode.name, "metadata": episode.metadata, "turns": turns}
+
+
+def _check_header(format_name, version) -> None:
+    if format_name != FORMAT_NAME:
+        raise ValueError(f"not a demonstration file: 'format' is {format_name!r}, expected {FORMAT_NAME!r}")
+    if version != FORMAT_VERSION:
+        raise ValueError(f"demonstration format version {version!r} is not supported; accepted: {FORMAT_VERSION}")
+
+
+def _episodes_from_json(path: Path) -> list[QuestioningEpisode]:
+    try:
+        document = json.loads(path.read_text(encoding="utf-8"))
+    except (json.JSONDecodeError, UnicodeDecodeError) as error:
+        raise ValueError(f"{path}: not valid JSON ({error})") from None
+    if not isinstance(document, dict):
+        raise ValueError("expected a JSON object with 'format', 'version', 'feature_names' and 'episodes'")
+    missing = [key for key in ("format", "version", "feature_names", "episodes") if key not in document]
+    if missing:
+        raise ValueError(f"missing field {missing[0]!r}; a demonstration file needs format, version, "
+                         "feature_names and episodes")
+    _check_header(document["format"], document["version"])
+    names = check_feature_names(document["feature_names"], "field 'feature_names'")
+    raw_episodes = document["episodes"]
+    if not isinstance(raw_episodes, list) or not raw_episodes:
+        raise ValueError("field 'episodes' must be a non-empty list of episodes")
+    episodes = []
+    for e, raw in enumerate(raw_episodes):
+        if not isinstance(raw, dict) or not isinstance(raw.get("turns"), list):
+            raise ValueError(f"episode {e}: expected an object with a 'turns' list")
+        unknown = sorted(set(raw) - {"name", "metadata", "turns"})
+        if unknown:
+            raise ValueError(f"episode {e}: unknown field {unknown[0]!r}; accepted: name, metadata, turns")
+        turns = []
+        for t, record in enumerate(raw["turns"]):
+            if not isinstance(record, dict) or "phi" not in record or "chosen" not in record:
+                raise ValueError(f"episode {e}, turn {t}: expected an object with 'phi' and 'chosen'")
+            unknown = sorted(set(record) - {"phi", "chosen", "kinds", "labels"})
+            if unknown:
+                raise ValueError(f"episode {e}, turn {t}: unknown field {unknown[0]!r}; "
+                                 "accepted: phi, chosen, kinds, labels")
+            try:
+                turns.append(DecisionTurn(record["phi"], record["chosen"], record.get("kinds"),
+                                          record.get("labels")))
+            except ValueError as error:
+                raise ValueError(f"episode {e}, turn {t}: {error}") from None
+        episodes.append(QuestioningEpisode(names, turns, raw.get("name", f"episode-{e}"), raw.get("metadata", {})))
+    return episodes
+
+
+def _episodes_to_arrays(names: tuple[str, ...], episodes: Sequence[QuestioningEpisode]) -> dict[str, np.ndarray]:
+    turns = [turn for episode in episodes for turn in episode.turns]
+    arrays = {
+        "format": np.array(FORMAT_NAME), "version": np.array(FORMAT_VERSION),
+        "feature_names": np.array(names),
+        "phi": np.vstack([turn.phi for turn in turns]),
+        "turn_offsets": np.cumsum([0] + [turn.n_actions for turn in turns]),
+        "chosen": np.array([turn.chosen for turn in turns], dtype=np.int64),
+        "episode_offsets": np.cumsum([0] + [len(episode.turns) for episode in episodes]),
+        "episode_names": np.array([episode.name for episode in episodes]),
+        "episode_metadata": np.array([json.dumps(episode.metadata) for episode in episodes]),
+    }
+    for attribute in ("kinds", "labels"):
+        present = [getattr(turn, attribute) is not None for turn in turns]
+        if any(present) and not all(present):
+            raise ValueError(f"NPZ needs action {attribute} on every turn or on none; mixed turns can go to JSON")
+        if all(present):
+            arrays[attribute] = np.array([value for turn in turns for value in getattr(turn, attribute)])
+    return arrays
+
+
+def _episodes_from_npz(path: Path) -> list[QuestioningEpisode]:
+    required = ("format", "version", "feature_names", "phi", "turn_offsets", "chosen", "episode_offsets",
+                "episode_names", "episode_metadata")
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            arrays = {key: data[key] for key in data.files}
+    except (OSError, ValueError, EOFError) as error:
+        raise ValueError(f"{path}: not a readable NPZ archive without pickled objects ({error})") from None
+    missing = [key for key in required if key not in arrays]
+    if missing:
+        raise ValueError(f"missing array {missing[0]!r}; a demonstration NPZ needs {', '.join(required)}")
+    _check_header(str(arrays["format"]), int(arrays["version"]) if arrays["version"].dtype.kind in "iu" else None)
+    names = check_feature_names([str(n) for n in arrays["feature_names"].tolist()], "array 'feature_names'")
+    phi, turn_offsets, chosen = arrays["phi"], arrays["turn_offsets"], arrays["chosen"]
+    episode_offsets = arrays["episode_offsets"]
+    n_turns = len(chosen)
+    if (turn_offsets.ndim != 1 or len(turn_offsets) != n_turns + 1 or turn_offsets[0] != 0
+            or np.any(np.diff(turn_offsets) < 1) or turn_offsets[-1] != len(phi)):
+        raise ValueError("array 'turn_offsets' must rise from 0 to the number of Phi rows, one step per turn")
+    if (episode_offsets.ndim != 1 or episode_offsets[0] != 0 or np.any(np.diff(episode_offsets) < 1)
+            or episode_offsets[-1] != n_turns or len(arrays["episode_names"]) != len(episode_offsets) - 1
+            or len(arrays["episode_metadata"]) != len(episode_offsets) - 1):
+        raise ValueError("arrays 'episode_offsets', 'episode_names' and 'episode_metadata' do not describe the turns")
+    extras = {}
+    for attribute in ("kinds", "labels"):
+        if attribute in arrays:
+            if len(arrays[attribute]) != len(phi):
+                raise ValueError(f"array {attribute!r} must have one entry per Phi row ({len(phi)})")
+            extras[attribute] = [str(v) for v in arrays[attribute].tolist()]
+    turns = []
+    for t in range(n_turns):
+        lo, hi = int(turn_offsets[t]), int(turn_offsets[t + 1])
+        try:
+            turns.append(DecisionTurn(phi[lo:hi], chosen[t], *(extras[a][lo:hi] if a in extras else None
+                                                              for a in ("kinds", "labels"))))
+        except ValueError as error:
+            raise ValueError(f"turn {t}: {error}") from None
+    episodes = []
+    for e in range(len(episode_offsets) - 1):
+        try:
+            metadata = json.loads(str(arrays["episode_metadata"][e]))
+        except json.JSONDecodeError:
+            raise ValueError(f"episode {e}: metadata is not valid JSON") from None
+        episodes.append(QuestioningEpisode(names, turns[episode_offsets[e]:episode_offsets[e + 1]],
+                                           str(arrays["episode_names"][e]), metadata))
+    return episodes
