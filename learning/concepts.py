@@ -10,7 +10,9 @@ import numpy as np
 
 from learning.gp import BinaryGPClassifier
 
-MIN_STD = 1e-6
+# A feature whose observed spread is below this fraction of its magnitude (or of 1) has shown no
+# variation yet; it keeps unit scale instead of blowing small test differences up to huge z-scores.
+RELATIVE_STD_FLOOR = 1e-3
 
 
 class FeatureScaler:
@@ -34,8 +36,10 @@ class FeatureScaler:
     def std(self) -> np.ndarray:
         if self._count == 0:
             return np.ones_like(self._sum)
-        var = self._sq / self._count - self.mean**2
-        return np.sqrt(np.maximum(var, 0.0)) + MIN_STD
+        mean = self.mean
+        spread = np.sqrt(np.maximum(self._sq / self._count - mean**2, 0.0))
+        floor = RELATIVE_STD_FLOOR * np.maximum(np.abs(mean), 1.0)
+        return np.where(spread > floor, spread, 1.0)
 
     def transform(self, X: np.ndarray) -> np.ndarray:
         return (X - self.mean) / self.std

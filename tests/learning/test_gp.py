@@ -58,3 +58,15 @@ def test_concept_models_start_from_the_prior_and_learn_from_one_example(rng):
     near = models.predict(np.zeros((1, 2)))[0]
     assert near[1] > 0.6 and near[0] == pytest.approx(0.5, abs=0.2) and near[2] < 0.4
     assert models.columns("a", 2).tolist() == [1] and models.columns("b", 2).tolist() == [0, 1]
+
+
+def test_a_feature_constant_so_far_does_not_swamp_the_others():
+    """A feature with no spread in what was observed keeps unit scale: a tiny test difference stays tiny."""
+    from learning.concepts import FeatureScaler
+
+    scaler = FeatureScaler(2)
+    scaler.update(np.array([[0.0, 0.02], [1.0, 0.02], [2.0, 0.02]]))
+    z = scaler.transform(np.array([[1.0, 0.03]]))
+    assert abs(z[0, 0]) < 1e-9
+    assert abs(z[0, 1]) < 0.1  # was 1e4 with an absolute 1e-6 floor
+    assert np.allclose(scaler.std[0], np.sqrt(2 / 3))
