@@ -10,8 +10,16 @@ from pathlib import Path
 from dialog.commands._arguments import budget, positive_int
 from dialog.regress.analysis import evaluate_findings, summarise
 from dialog.regress.baseline import check_against_baseline, write_baseline
-from dialog.regress.episodes import load_pools
 from dialog.regress.feature_report import feature_summaries, run_feature_suite, write_feature_report
+from dialog.regress.pools import load_pools
+from dialog.regress.recipe_report import write_recipe_report
+from dialog.regress.recipe_suite import (
+    evaluate_recipe_findings,
+    load_study,
+    run_recipe_suite,
+    summarise_study,
+    trial_count,
+)
 from dialog.regress.report import markdown_report, plot_learning_curves, plot_question_timing, write_episode_csvs
 from dialog.regress.runner import episode_specs, run_locally, run_on_ray
 from dialog.regress.suite import load_suite, suite_names
@@ -26,8 +34,6 @@ def register(commands) -> None:
     parser.add_argument("--seeds", nargs="+", type=int, default=None, help="override the suite's seeds")
     parser.add_argument("--budget", type=budget, default=None, help="override every condition's budget")
     parser.add_argument("--datasets", type=positive_int, default=None, help="override the number of data sets")
-    parser.add_argument("--pool-scenes", type=positive_int, default=None,
-                        help="scenes rendered per training pool (default: the suite's, else 30)")
     parser.add_argument("--workers", type=positive_int, default=None, help="local worker processes (default: cores)")
     parser.add_argument("--ray", metavar="ADDRESS", default=None,
                         help="run the episodes on the Ray cluster at ADDRESS ('local' starts one here)")
@@ -47,17 +53,17 @@ def run(args: argparse.Namespace) -> int:
             raise ValueError(f"unknown strategies {unknown}; choose from: {', '.join(STRATEGY_NAMES)}")
     out = args.results or Path("results") / suite.name
     out.mkdir(parents=True, exist_ok=True)
-    pool_scenes = args.pool_scenes or int(suite.options.get("pool_scenes", 30))
     started = time.perf_counter()
     if suite.kind == "feature-selection":
-        rows = run_feature_suite(suite, load_pools(suite.task, suite.kitchen, 1, pool_scenes))
+        rows = run_feature_suite(suite, load_pools(suite.task, suite.kitchen, 1, suite.plan_options))
         seconds = time.perf_counter() - started
         summaries = feature_summaries(rows, suite)
         findings = evaluate_findings(summaries, suite)
         report = write_feature_report(suite, rows, summaries, findings, seconds, out)
         count = len(rows)
     elif suite.kind == "episodes":
-        specs = episode_specs(suite, out, pool_scenes)
+        load_pools(suite.task, suite.kitchen, suite.datasets, suite.plan_options)  # render once, before workers
+        specs = episode_specs(suite, out)
         progress = not args.no_progress
         results = run_on_ray(specs, args.ray, progress) if args.ray else run_locally(specs, args.workers, progress)
         seconds = time.perf_counter() - started
@@ -67,6 +73,14 @@ def run(args: argparse.Namespace) -> int:
         figures = plot_learning_curves(results, suite, out) + plot_question_timing(results, suite, out)
         report = markdown_report(suite, results, summaries, findings, seconds, out, figures)
         count = len(results)
+    elif suite.kind == "recipes":
+        study = load_study(suite)
+        results = run_recipe_suite(study, args.workers, not args.no_progress)
+        seconds = time.perf_counter() - started
+        summaries = summarise_study(results, study)
+        findings = evaluate_recipe_findings(summaries, suite)
+        count = trial_count(results)
+        report = write_recipe_report(suite, study, results, summaries, findings, seconds, out, count)
     else:
         raise ValueError(f"suite '{suite.name}' is of kind '{suite.kind}', which this version cannot run yet")
     print(f"{suite.name}: {count} runs in {seconds:.1f} s; report {report}")

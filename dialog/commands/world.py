@@ -50,6 +50,10 @@ def register(commands) -> None:
                       help="cache folder (default $TEACHBOT_CACHE or ~/.cache/teachbot)")
     data.add_argument("--no-robot", action="store_true", help="leave the arm out (its features too)")
     data.add_argument("--rebuild", action="store_true", help="render the data sets again even if cached")
+    data.add_argument("--pool-size", type=positive_int, default=None,
+                      help="objects per training pool (default: the task's [datasets] plan)")
+    data.add_argument("--test-size", type=positive_int, default=None,
+                      help="objects in the test pool (default: the task's [datasets] plan)")
     data.add_argument("--json", action="store_true", help="end with one JSON line")
     data.set_defaults(handler=run_data)
 
@@ -105,14 +109,19 @@ def run_check(args: argparse.Namespace) -> int:
 
 
 def run_data(args: argparse.Namespace) -> int:
+    from dataclasses import replace
+
+    from bullet_world.catalogue import load_task
     from bullet_world.datasets import load_datasets
 
+    plan = load_task(args.task).datasets
+    plan = replace(plan, pool_size=args.pool_size or plan.pool_size, test_size=args.test_size or plan.test_size)
     robot_factory = None
     if not args.no_robot:
         from robot import Arm
 
         robot_factory = Arm
-    datasets = load_datasets(args.task, args.kitchen, args.seed, robot_factory=robot_factory, cache=args.cache,
+    datasets = load_datasets(args.task, args.kitchen, args.seed, plan, robot_factory=robot_factory, cache=args.cache,
                              rebuild=args.rebuild, progress=lambda m: print(m, file=sys.stderr, flush=True))
     meta = datasets.metadata
     sizes = [len(pool) for pool in datasets.train]

@@ -47,7 +47,7 @@ def check_against_baseline(suite: Suite, summaries: list[CheckpointSummary], pat
         bands = json.loads(path.read_text(encoding="utf-8"))["bands"]
     except (json.JSONDecodeError, KeyError) as error:
         return [f"baseline {path} is unreadable ({error}); rewrite it with --update-baseline"]
-    axis = "questions" if suite.axis == "questions" else "turns"
+    axis = suite.axis  # questions, turns or demonstrations
     failures = []
     for s in summaries:
         stored = bands.get(s.condition, {}).get(s.strategy)

@@ -8,13 +8,12 @@ from __future__ import annotations
 
 import time
 from dataclasses import asdict, dataclass
-from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
 
 from dialog.manager import DialogManager, EpisodeConfig, episode_generators
-from dialog.regress.pools import ObservationPool, PoolEnvironment
+from dialog.regress.pools import PoolEnvironment, load_pools
 from dialog.regress.suite import Condition
 from dialog.transcript import TranscriptWriter, read_transcript
 from learning.strategies import make_strategy
@@ -34,7 +33,7 @@ class EpisodeSpec:
     costs: tuple  # ((kind, cost), ...), hashable
     teacher: tuple  # ((option, value), ...)
     transcript: str
-    pool_scenes: int
+    plan: tuple = ()  # ((data-set plan option, value), ...), see dialog.regress.pools.PLAN_OPTIONS
 
     @property
     def episode_seed(self) -> int:
@@ -46,42 +45,30 @@ class EpisodeSpec:
         return f"{self.strategy}/{self.condition.name}/d{self.dataset}/s{self.seed}"
 
 
-@lru_cache(maxsize=4)
-def load_pools(task: str, kitchen: str, datasets: int, pool_scenes: int) -> tuple:
-    """``datasets`` disjoint training pools and one test pool, each of ``pool_scenes`` rendered scenes."""
-    from bullet_world import World
-    from robot import Arm
-
-    with World(task=task, kitchen=kitchen, seed=0) as world:
-        Arm(world)
-        pools = []
-        for index in range(datasets + 1):
-            rng = np.random.default_rng([7, index])  # pool index -> disjoint streams of scenes
-            scenes = [world.new_scene(rng) for _ in range(pool_scenes)]
-            pools.append(ObservationPool(
-                X=np.vstack([s.X for s in scenes]),
-                concepts=np.array([c for s in scenes for c in s.truth.concepts], dtype=object),
-                kinds=np.array([k for s in scenes for k in s.truth.kinds], dtype=object),
-                feature_names=scenes[0].feature_names,
-            ))
-        return tuple(pools[:-1]), pools[-1], world.task.concepts, world.task.objects_per_scene
+TEACHER_OPTIONS = ("kind", "mislabel_rate", "dont_know_rate", "feature_quality")
 
 
 def make_teacher(options: dict, rng: np.random.Generator):
-    from dialog.teachers import OracleTeacher
+    """A scripted teacher (``kind = "scripted"``, the default; ``"oracle"`` = perfect) from suite options."""
+    from dialog.teachers import OracleTeacher, ScriptedTeacher
 
-    unknown = sorted(set(options) - {"kind"})
-    if options.get("kind", "oracle") != "oracle" or unknown:
-        raise ValueError(f"teacher options {options} not supported; accepted: kind = 'oracle'")
-    return OracleTeacher(rng)
+    unknown = sorted(set(options) - set(TEACHER_OPTIONS))
+    kind = options.get("kind", "scripted")
+    if unknown or kind not in ("scripted", "oracle"):
+        raise ValueError(f"teacher options {options} not supported; accepted: kind = 'scripted' or 'oracle', "
+                         f"mislabel_rate, dont_know_rate, feature_quality (each 0..1)")
+    if kind == "oracle":
+        return OracleTeacher(rng)
+    return ScriptedTeacher(rng, **{k: float(v) for k, v in options.items() if k != "kind"})
 
 
 def run_episode(spec: EpisodeSpec) -> dict:
     """Run one episode; returns its spec, per-turn series, final accuracy and wall time."""
     started = time.perf_counter()
-    train, test, concepts, objects = load_pools(spec.task, spec.kitchen, spec.dataset + 1, spec.pool_scenes)
-    environment = PoolEnvironment(train[spec.dataset], test, concepts, objects)
+    pools = load_pools(spec.task, spec.kitchen, spec.dataset + 1, spec.plan)
     condition = spec.condition
+    scenes = -(-condition.turns // max(condition.change_every, 1))
+    environment = PoolEnvironment(pools.train[spec.dataset], pools.test, pools.task, scenes)
     config = EpisodeConfig(turns=condition.turns, budget=condition.budget, change_every=condition.change_every,
                            seed=spec.episode_seed, costs=dict(spec.costs))
     rngs = episode_generators(spec.episode_seed)

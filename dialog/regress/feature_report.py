@@ -17,7 +17,7 @@ from learning.significance import mean_and_standard_error
 
 def run_feature_suite(suite: Suite, pools) -> list[dict]:
     """The study over the suite's first training pool and the test pool."""
-    train, test, _, _ = pools
+    train, test = pools.train, pools.test
     options = suite.options
     relevant = set(options.get("relevant_features", [])) or _task_relevant(suite)
     user = UserModel(**options.get("user_model", {}))
@@ -100,6 +100,8 @@ def write_feature_report(suite: Suite, rows: list[dict], summaries: list[Checkpo
                 lines.append(f"| {outcome.finding.id}: {outcome.finding.text} | {c.a} > {c.b} | {c.mean_a:.3f} vs "
                              f"{c.mean_b:.3f} | {c.u:.1f} | {_fmt_p(c.p)} | {'yes' if c.significant else 'no'} |")
         lines.append("")
+        if suite.analysis:
+            lines += [f"Why each finding holds or not, and what differs from the thesis: {suite.analysis}", ""]
     path = out / "report.md"
     path.write_text("\n".join(lines) + "\n", encoding="utf-8")
     return path

@@ -17,7 +17,7 @@ import numpy as np
 from sklearn.preprocessing import StandardScaler
 from sklearn.svm import SVC
 
-from dialog.regress.pools import ObservationPool
+from bullet_world.datasets import Pool
 from learning.feature_selection import select_features
 
 COMPUTATIONAL = ("none", "FI", "ES", "ER")
@@ -74,7 +74,7 @@ def hfr_answer(names, relevant: set[str], user: UserModel, rng: np.random.Genera
     return np.array(kept or [i for i, name in enumerate(names) if name in relevant])
 
 
-def his_examples(pool: ObservationPool, rng: np.random.Generator, per_concept: int = 3) -> np.ndarray:
+def his_examples(pool: Pool, rng: np.random.Generator, per_concept: int = 3) -> np.ndarray:
     """Three representative examples per concept: as many different kinds as possible (an apple, an orange...)."""
     rows = []
     for concept in sorted(set(pool.concepts.tolist())):
@@ -99,7 +99,7 @@ def svm_accuracy(train_X, train_y, test_X, test_y, features: np.ndarray) -> floa
     return float(np.mean(model.predict(scaler.transform(test_X[:, features])) == test_y))
 
 
-def run_study(train: ObservationPool, test: ObservationPool, relevant: set[str], sizes=(12, 100), samples: int = 10,
+def run_study(train: Pool, test: Pool, relevant: set[str], sizes=(12, 100), samples: int = 10,
               users: int = 10, user_model: UserModel = UserModel(), seed: int = 0, methods=METHODS) -> list[dict]:
     """Rows of (method, n, sample, user, accuracy, features) for every approach of table 5.2."""
     unknown = [m for m in methods if m not in METHODS]

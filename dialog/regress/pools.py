@@ -2,60 +2,124 @@
 
 As in the thesis, every new scene samples one observation per scene object
 from a training pool, stratified over the concepts; accuracy is measured on a
-held-out test pool. Pools come from the simulator (see ``load_pools``).
+held-out test pool. The pools are the simulator's cached data sets
+(:func:`bullet_world.datasets.load_datasets`, with the Panda attached so its
+features are in every row).
+
+Groundings that change over time (prepare-lunch, thesis §6.6.2) follow the
+episode's clock: a kind with states in order (pasta boxed -> in a pot -> in a
+bowl) is drawn in the state that matches how far the episode has gone, so the
+main dish the robot sees early looks unlike the one it sees late, while the
+test pool keeps every state.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
+from functools import lru_cache
 
 import numpy as np
 
+from bullet_world.catalogue import Task, load_task
+from bullet_world.datasets import Pool, load_datasets
 from bullet_world.scene import Scene, SceneTruth
+
+PLAN_OPTIONS = ("pool_size", "test_size", "objects_per_scene")
 
 
 @dataclass(frozen=True)
-class ObservationPool:
-    """Rows of observed objects: features, true concept and kind of each."""
+class PoolSet:
+    """The training pools, the test pool and the task they were rendered for."""
 
-    X: np.ndarray
-    concepts: np.ndarray
-    kinds: np.ndarray
-    feature_names: tuple[str, ...]
+    train: tuple[Pool, ...]
+    test: Pool
+    task: Task
 
-    def __post_init__(self):
-        if not (len(self.X) == len(self.concepts) == len(self.kinds)):
-            raise ValueError(f"pool arrays differ in length: X {len(self.X)}, concepts {len(self.concepts)}, "
-                             f"kinds {len(self.kinds)}")
+
+@lru_cache(maxsize=4)
+def load_pools(task: str, kitchen: str, datasets: int, plan_options: tuple = ()) -> PoolSet:
+    """``datasets`` training pools and the test pool, from the cache (rendered once, then reused).
+
+    ``plan_options`` ((name, value), ...) overrides the task's data-set plan (``pool_size``,
+    ``test_size``, ``objects_per_scene``); accepted names are listed in the error otherwise.
+    """
+    from robot import Arm
+
+    loaded = load_task(task)
+    options = dict(plan_options)
+    unknown = sorted(set(options) - set(PLAN_OPTIONS))
+    if unknown:
+        raise ValueError(f"unknown data-set options {unknown}; accepted: {', '.join(PLAN_OPTIONS)}")
+    plan = replace(loaded.datasets, **{name: int(value) for name, value in options.items()})
+    plan = replace(plan, pools=max(datasets, plan.pools))  # fewer pools reuse the task's cached set
+    sets = load_datasets(task, kitchen, seed=0, plan=plan, robot_factory=Arm)
+    return PoolSet(sets.train[:datasets], sets.test, loaded)
+
+
+def state_order(task: Task) -> dict[str, tuple[str, ...]]:
+    """Each kind's states in the order they happen (kinds without states are left out)."""
+    return {kind.name: kind.state_names for kind in task.kinds if len(kind.states) > 1}
 
 
 class PoolEnvironment:
     """The manager's environment over a training pool and a test pool (no arm: nothing to point with)."""
 
-    def __init__(self, train: ObservationPool, test: ObservationPool, concepts, objects_per_scene: int):
+    def __init__(self, train: Pool, test: Pool, task: Task, scenes_per_episode: int = 1):
+        concepts = task.concepts
         missing = sorted(set(concepts) - set(train.concepts.tolist()))
         if missing:
             raise ValueError(f"training pool has no observations of {missing}")
         self.train, self.test = train, test
         self.concepts = tuple(concepts)
-        self.feature_names = train.feature_names
-        self.objects_per_scene = objects_per_scene
-        self.test_scenes = 0
-        self._by_concept = {c: np.nonzero(train.concepts == c)[0] for c in self.concepts}
+        self.feature_names = tuple(train.feature_names)
+        self.objects_per_scene = task.objects_per_scene
+        self.relevant_features = task.relevant_features
+        self.scenes_per_episode = max(int(scenes_per_episode), 1)
+        self._by_concept = {c: np.flatnonzero(train.concepts == c) for c in self.concepts}
+        self._stage_of_row = self._stages(train, state_order(task))
         self._scene_count = 0
+
+    @staticmethod
+    def _stages(pool: Pool, order: dict[str, tuple[str, ...]]) -> np.ndarray:
+        """For every row, its state's place in its kind's order as a fraction in [0, 1) (-1: no states)."""
+        stages = np.full(len(pool), -1.0)
+        for row, (kind, state) in enumerate(zip(pool.kinds.tolist(), pool.states.tolist())):
+            states = order.get(kind)
+            if states and state in states:
+                stages[row] = states.index(state) / len(states)
+        return stages
+
+    def _rows_now(self, concept: str, progress: float) -> np.ndarray:
+        """Rows of ``concept`` whose state matches the episode's progress (all rows of stateless kinds)."""
+        rows = self._by_concept[concept]
+        stages = self._stage_of_row[rows]
+        if (stages < 0).all():
+            return rows
+        # a row's state spans [stage, stage + 1/len(states)); pick the latest state begun by now
+        begun = rows[(stages >= 0) & (stages <= progress)]
+        if len(begun):
+            latest = self._stage_of_row[begun].max()
+            current = begun[self._stage_of_row[begun] == latest]
+            return np.concatenate([current, rows[stages < 0]])
+        return rows
 
     def next_scene(self, rng: np.random.Generator) -> Scene:
         """One observation per scene object, concepts as evenly represented as the count allows."""
+        progress = min(self._scene_count / self.scenes_per_episode, 1.0)
         sequence = [self.concepts[i % len(self.concepts)] for i in range(self.objects_per_scene)]
         rng.shuffle(sequence)
-        rows = np.array([self._by_concept[c][rng.integers(len(self._by_concept[c]))] for c in sequence])
+        rows = []
+        for concept in sequence:
+            candidates = self._rows_now(concept, progress)
+            rows.append(candidates[rng.integers(len(candidates))])
+        rows = np.array(rows)
         self._scene_count += 1
         n = len(rows)
-        X = self.train.X[rows]
         truth = SceneTruth(tuple(self.train.concepts[rows].tolist()), tuple(self.train.kinds[rows].tolist()),
-                           tuple(rows.tolist()), np.zeros((n, 3)), np.zeros((n, 3)))
-        return Scene(self._scene_count, X, self.feature_names, np.zeros((n, 3)), np.zeros(n), np.zeros((n, 3)),
-                     truth)
+                           tuple(rows.tolist()), np.zeros((n, 3)), np.zeros((n, 3)),
+                           states=tuple(self.train.states[rows].tolist()))
+        return Scene(self._scene_count, self.train.X[rows], self.feature_names, np.zeros((n, 3)), np.zeros(n),
+                     np.zeros((n, 3)), truth)
 
     def point_at(self, scene: Scene, object_index: int) -> dict:
         return {"simulated": False}

@@ -129,7 +129,7 @@ def markdown_report(suite: Suite, results: list[dict], summaries: list[Checkpoin
     axis_name = "questions asked" if suite.axis == "questions" else "turns"
     lines = [f"# Regression report: {suite.name}", "", suite.description, "",
              f"- task `{suite.task}`, kitchen `{suite.kitchen}`, {suite.datasets} training data sets, "
-             f"seeds {list(suite.seeds)}, teacher {suite.teacher or {'kind': 'oracle'}}",
+             f"seeds {list(suite.seeds)}, teacher {suite.teacher or {'kind': 'scripted'}}",
              f"- {len(results)} episodes in {seconds:.1f} s of wall time "
              f"({sum(r['seconds'] for r in results):.1f} s of episode time)",
              "- per-episode CSV: [episodes.csv](episodes.csv) (one row per episode, linking its per-turn CSV)", ""]
@@ -167,6 +167,8 @@ def markdown_report(suite: Suite, results: list[dict], summaries: list[Checkpoin
                              f"{'yes' if c.significant else 'no'} |")
         lines += ["", "Summary: " + "; ".join(f"{o.finding.id} {'holds' if o.holds else 'does not hold'}"
                                                for o in findings) + ".", ""]
+        if suite.analysis:
+            lines += [f"Why each finding holds or not, and what differs from the thesis: {suite.analysis}", ""]
     path = out / "report.md"
     path.write_text("\n".join(lines) + "\n", encoding="utf-8")
     return path

@@ -12,7 +12,7 @@ from dialog.regress.episodes import EpisodeSpec, run_episode
 from dialog.regress.suite import Suite
 
 
-def episode_specs(suite: Suite, results_dir: Path, pool_scenes: int) -> list[EpisodeSpec]:
+def episode_specs(suite: Suite, results_dir: Path) -> list[EpisodeSpec]:
     """Every (condition, strategy, data set, seed) of the suite, in a stable order."""
     specs = []
     for condition in suite.conditions:
@@ -24,7 +24,7 @@ def episode_specs(suite: Suite, results_dir: Path, pool_scenes: int) -> list[Epi
                         suite=suite.name, task=suite.task, kitchen=suite.kitchen, strategy=strategy,
                         condition=condition, dataset=dataset, seed=seed, costs=tuple(sorted(suite.costs.items())),
                         teacher=tuple(sorted(suite.teacher.items())), transcript=str(transcript),
-                        pool_scenes=pool_scenes))
+                        plan=suite.plan_options))
     return specs
 
 

@@ -16,7 +16,7 @@ from pathlib import Path
 
 SUITE_DIR = Path(__file__).resolve().parents[1] / "suites"
 KINDS = ("episodes", "feature-selection", "recipes")
-AXES = ("questions", "turns")
+AXES = ("questions", "turns", "demonstrations")
 
 
 class SuiteError(ValueError):
@@ -42,6 +42,8 @@ class Finding:
     better: str
     than: tuple[str, ...]
     alternative: str = "greater"
+    than_at: int | None = None  # recipes suites: compare with ``than`` at this checkpoint instead of ``at``
+    margin: float = 0.0         # recipes suites: ``better`` + margin beats ``than`` (non-inferiority)
 
 
 @dataclass(frozen=True)
@@ -62,6 +64,13 @@ class Suite:
     findings: tuple[Finding, ...] = ()
     options: dict = field(default_factory=dict)
     path: str = ""
+    dataset: dict = field(default_factory=dict)  # overrides of the task's data-set plan ([dataset] table)
+    analysis: str = ""  # where the written analysis of the findings lives (shown in the report)
+
+    @property
+    def plan_options(self) -> tuple:
+        """The ``[dataset]`` table as a hashable ((name, value), ...) for :func:`dialog.regress.pools.load_pools`."""
+        return tuple(sorted(self.dataset.items()))
 
     def with_overrides(self, strategies=None, seeds=None, budget=None, datasets=None) -> Suite:
         """The suite with command-line overrides applied."""
@@ -135,7 +144,7 @@ def load_suite(name_or_path: str | Path, known_strategies=None) -> Suite:
         default_condition = f"n{f.get('at')}" if kind == "feature-selection" else ""
         finding = Finding(_need(f, "id", str, at), _need(f, "text", str, at), f.get("condition", default_condition),
                           _need(f, "at", int, at), _need(f, "better", str, at), tuple(_need(f, "than", list, at)),
-                          f.get("alternative", "greater"))
+                          f.get("alternative", "greater"), *_recipe_finding_extras(f, kind, at))
         missing = [s for s in (finding.better, *finding.than) if s not in strategies]
         if missing:
             raise SuiteError(f"{at}: strategies {missing} are not in the suite's strategies")
@@ -149,4 +158,19 @@ def load_suite(name_or_path: str | Path, known_strategies=None) -> Suite:
         seeds=tuple(table.get("seeds", [0])), checkpoints=tuple(_need(table, "checkpoints", list, where)),
         axis=axis, costs=dict(table.get("costs", {})), teacher=dict(table.get("teacher", {})),
         findings=tuple(findings), options=dict(table.get("options", {})), path=where,
+        dataset=dict(table.get("dataset", {})), analysis=str(table.get("analysis", "")),
     )
+
+
+def _recipe_finding_extras(table: dict, kind: str, where: str) -> tuple[int | None, float]:
+    """``than_at`` and ``margin`` of a finding: only a recipes suite compares across checkpoints."""
+    if kind != "recipes":
+        extra = [key for key in ("than_at", "margin") if key in table]
+        if extra:
+            raise SuiteError(f"{where}: '{extra[0]}' is only accepted in a suite of kind 'recipes'")
+        return None, 0.0
+    than_at = _need(table, "than_at", int, where) if "than_at" in table else None
+    margin = _need(table, "margin", float, where) if "margin" in table else 0.0
+    if margin < 0:
+        raise SuiteError(f"{where}: 'margin' must be >= 0, got {margin}")
+    return than_at, margin

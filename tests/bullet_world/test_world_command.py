@@ -32,7 +32,8 @@ def test_world_check_ends_with_one_json_line(capsys):
 
 
 def test_world_data_builds_then_reuses_the_cache(tmp_path, capsys):
-    arguments = ["world", "data", "--task", "prepare-lunch", "--no-robot", "--cache", str(tmp_path), "--json"]
+    arguments = ["world", "data", "--task", "prepare-lunch", "--no-robot", "--cache", str(tmp_path), "--json",
+                 "--pool-size", "80", "--test-size", "40"]
     assert main(arguments) == 0
     first = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
     assert first["train"] == [80] * 5 and first["test"] == 40 and first["features"] == 56

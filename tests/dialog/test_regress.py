@@ -16,8 +16,9 @@ description = "test suite"
 strategies = ["passive", "active"]
 datasets = 2
 checkpoints = [1, 2, 3]
-[options]
-pool_scenes = 2
+[dataset]
+pool_size = 24
+test_size = 24
 [costs]
 label = 1
 demo = 1
