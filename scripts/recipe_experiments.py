@@ -14,7 +14,9 @@ tested on the demonstrations of the test kitchen that were not used to train.
 
 Writes plots to ``--out`` (docs/img by default), prints Markdown tables, and
 with ``--json`` ends with one JSON line of all numbers. One ``--seed`` drives
-every random choice.
+every random choice. The experiments live in ``dialog/regress/recipe_study.py``
+(also run, in parallel and with significance tests, by ``teachbot regress
+--suite recipes``).
 
     python scripts/recipe_experiments.py --json
 """
@@ -22,7 +24,6 @@ every random choice.
 from __future__ import annotations
 
 import argparse
-import itertools
 import json
 import sys
 import time
@@ -32,179 +33,11 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from bullet_world.catalogue import load_kitchen
-from bullet_world.recipe_tracking import match_rows
-from bullet_world.recipe_world import RecipeDemonstration, RecipeWorld
-from dialog.commands._recipe_session import evaluate_demonstration, ground, parameter_names, recipe_steps
-from learning.recipe import Recipe, load_builtin_recipe, recipe_parameters
+from dialog.regress.recipe_figures import markdown_cv, markdown_transfer, plot_cross_validation, plot_transfer
+from dialog.regress.recipe_study import collect, cross_validation, transfer, varied_pairs
+from learning.recipe import load_builtin_recipe, recipe_parameters
 
 DEFAULT_KITCHENS = ("kitchen-1", "kitchen-2", "kitchen-3")
-# Objects dashed, locations solid (the three object curves often coincide: lighting decides them).
-OBJECT_STYLES = tuple({"linestyle": "--", "marker": m, "markersize": 5, "alpha": 0.8} for m in ("o", "s", "^"))
-LOCATION_STYLES = tuple({"linestyle": "-", "marker": m, "markersize": 3} for m in ("o", "v", "D", "x"))
-
-
-def collect(recipe: Recipe, task: str, kitchen: str, count: int, seed: int) -> list[RecipeDemonstration]:
-    """``count`` scripted demonstrations of ``recipe`` in ``kitchen`` (camera + perception, no arm)."""
-    with RecipeWorld(recipe_steps(recipe), task=task, kitchen=kitchen, seed=seed) as world:
-        return world.demonstrate(count, np.random.default_rng([seed, 11]))
-
-
-def accuracy(recipe: Recipe, train: list[RecipeDemonstration], test: list[RecipeDemonstration],
-             rng: np.random.Generator) -> dict[str, float]:
-    """Fraction of successful trials per parameter when trained on ``train`` and tested on ``test``."""
-    grounding = ground(recipe, train, rng)
-    trials: dict[str, list[bool]] = {name: [] for name in parameter_names(recipe)}
-    for demonstration in test:
-        for name, results in evaluate_demonstration(grounding, recipe, demonstration).items():
-            trials[name].extend(results)
-    return {name: float(np.mean(results)) for name, results in trials.items()}
-
-
-def cross_validation(recipe: Recipe, demos: list[RecipeDemonstration], repeats: int,
-                     rng: np.random.Generator) -> dict[str, list[float]]:
-    """Mean accuracy per parameter for m = 1..n-1 training demonstrations (figure 4.6)."""
-    n = len(demos)
-    curves: dict[str, list[float]] = {name: [] for name in parameter_names(recipe)}
-    for m in range(1, n):
-        runs = []
-        for _ in range(repeats):
-            chosen = set(rng.choice(n, size=m, replace=False).tolist())
-            train = [demos[i] for i in sorted(chosen)]
-            test = [demos[i] for i in range(n) if i not in chosen]
-            runs.append(accuracy(recipe, train, test, rng))
-        for name in curves:
-            curves[name].append(float(np.mean([run[name] for run in runs])))
-    return curves
-
-
-def edit_distance(first: RecipeDemonstration, second: RecipeDemonstration) -> float:
-    """Environment edit distance of two demonstrations (eq. 4.4), over their initial states.
-
-    Eq. 4.4 sums dist (eq. 4.1) over every pair of objects; here each object is paired with itself
-    (rows matched by ``recipe_tracking``), so objects that stay put add nothing.
-    """
-    a, b = first.steps[0].before, second.steps[0].before
-    order = match_rows(a.appearance, a.locations, b.appearance, b.locations)
-    return float(np.sum(np.linalg.norm(b.locations[order] - a.locations, axis=1)))
-
-
-def varied_pairs(recipe: Recipe, demos: list[RecipeDemonstration], rng: np.random.Generator) -> dict:
-    """Every pair of demonstrations as training set (m = 2): mean accuracy of the third of pairs with
-    the largest edit distance vs. the third with the smallest (thesis §4.4.1, figure 4.7)."""
-    rows = []
-    for i, j in itertools.combinations(range(len(demos)), 2):
-        test = [d for k, d in enumerate(demos) if k not in (i, j)]
-        result = accuracy(recipe, [demos[i], demos[j]], test, rng)
-        rows.append((edit_distance(demos[i], demos[j]), float(np.mean(list(result.values())))))
-    rows.sort()
-    third = max(1, len(rows) // 3)
-    return {"pairs": len(rows), "least_varied_accuracy": float(np.mean([a for _, a in rows[:third]])),
-            "most_varied_accuracy": float(np.mean([a for _, a in rows[-third:]])),
-            "least_varied_distance_m": float(np.mean([d for d, _ in rows[:third]])),
-            "most_varied_distance_m": float(np.mean([d for d, _ in rows[-third:]]))}
-
-
-def transfer(recipe: Recipe, demos: dict[str, list[RecipeDemonstration]], m_values: list[int], repeats: int,
-             rng: np.random.Generator) -> list[dict]:
-    """Accuracy per parameter in every test kitchen for models trained in every set of kitchens (figure 4.8)."""
-    kitchens = list(demos)
-    rows = []
-    for m in m_values:
-        for size in range(1, len(kitchens) + 1):
-            for training in itertools.combinations(kitchens, size):
-                for test_kitchen in kitchens:
-                    runs = []
-                    for _ in range(repeats):
-                        train, used = [], {}
-                        for kitchen in training:
-                            chosen = sorted(rng.choice(len(demos[kitchen]), size=m, replace=False).tolist())
-                            used[kitchen] = set(chosen)
-                            train.extend(demos[kitchen][i] for i in chosen)
-                        held_out = used.get(test_kitchen, set())
-                        test = [d for i, d in enumerate(demos[test_kitchen]) if i not in held_out]
-                        runs.append(accuracy(recipe, train, test, rng))
-                    mean = {name: float(np.mean([run[name] for run in runs])) for name in runs[0]}
-                    rows.append({"m": m, "train": list(training), "test": test_kitchen,
-                                 "situated": test_kitchen in training, "accuracy": mean,
-                                 "mean": float(np.mean(list(mean.values())))})
-    return rows
-
-
-def plot_cross_validation(curves: dict[str, dict[str, list[float]]], objects: tuple[str, ...], path: Path) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    figure, axes = plt.subplots(1, len(curves), figsize=(4.6 * len(curves), 3.8), squeeze=False, sharey=True)
-    for axis, (kitchen, per_parameter) in zip(axes[0], curves.items()):
-        for number, (name, values) in enumerate(per_parameter.items()):
-            styles = OBJECT_STYLES if name in objects else LOCATION_STYLES
-            axis.plot(range(1, len(values) + 1), values, label=name, **styles[number % len(styles)])
-        axis.set_title(f"serve-pasta, {kitchen}")
-        axis.set_xlabel("training demonstrations m")
-        axis.set_ylim(-0.02, 1.02)
-        axis.grid(alpha=0.3)
-    axes[0][0].set_ylabel("accuracy on held-out demonstrations")
-    axes[0][-1].legend(fontsize=8, loc="lower right")
-    figure.tight_layout()
-    figure.savefig(path, dpi=110)
-    plt.close(figure)
-
-
-def plot_transfer(rows: list[dict], test_kitchen: str, path: Path) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    m_values = sorted({row["m"] for row in rows})
-    figure, axes = plt.subplots(1, len(m_values), figsize=(6.5 * len(m_values), 3.8), squeeze=False, sharey=True)
-    for axis, m in zip(axes[0], m_values):
-        chosen = [row for row in rows if row["m"] == m and row["test"] == test_kitchen]
-        chosen.sort(key=lambda row: (row["situated"], len(row["train"]), row["train"]))
-        parameters = list(chosen[0]["accuracy"])
-        width = 0.8 / len(chosen)
-        blues, reds = plt.cm.Blues, plt.cm.Reds
-        n_out = sum(not row["situated"] for row in chosen)
-        for index, row in enumerate(chosen):
-            shade = 0.45 + 0.5 * ((index if not row["situated"] else index - n_out) + 1) / (len(chosen) + 1)
-            colour = (reds if row["situated"] else blues)(shade)
-            label = "+".join(k.replace("kitchen-", "K") for k in row["train"])
-            positions = np.arange(len(parameters)) + (index - (len(chosen) - 1) / 2) * width
-            axis.bar(positions, [row["accuracy"][p] for p in parameters], width, color=colour, label=label)
-        axis.set_xticks(range(len(parameters)), parameters, fontsize=8)
-        axis.set_title(f"serve-salad tested in {test_kitchen}, {m} demos per training kitchen")
-        axis.set_ylim(0, 1.05)
-        axis.grid(axis="y", alpha=0.3)
-    axes[0][0].set_ylabel("accuracy")
-    handles, labels = axes[0][0].get_legend_handles_labels()
-    figure.legend(handles, labels, loc="lower center", ncol=len(labels), fontsize=8,
-                  title="trained in (blue: without the test kitchen, red: with it)", title_fontsize=8)
-    figure.tight_layout(rect=(0, 0.12, 1, 1))
-    figure.savefig(path, dpi=110)
-    plt.close(figure)
-
-
-def markdown_cv(kitchen: str, per_parameter: dict[str, list[float]]) -> str:
-    count = len(next(iter(per_parameter.values())))
-    lines = [f"serve-pasta, {kitchen}: accuracy per parameter vs. training demonstrations m", "",
-             "| parameter | " + " | ".join(f"m={m}" for m in range(1, count + 1)) + " |",
-             "|---|" + "---:|" * count]
-    lines += [f"| {name} | " + " | ".join(f"{v:.2f}" for v in values) + " |" for name, values in per_parameter.items()]
-    return "\n".join(lines)
-
-
-def markdown_transfer(rows: list[dict]) -> str:
-    parameters = list(rows[0]["accuracy"])
-    lines = ["| m | trained in | tested in | " + " | ".join(parameters) + " | mean |",
-             "|---:|---|---|" + "---:|" * (len(parameters) + 1)]
-    for row in rows:
-        values = " | ".join(f"{row['accuracy'][p]:.2f}" for p in parameters)
-        mark = "**" if row["situated"] else ""
-        lines.append(f"| {row['m']} | {mark}{'+'.join(row['train'])}{mark} | {row['test']} | {values} | "
-                     f"{row['mean']:.2f} |")
-    return "\n".join(lines)
 
 
 def available_kitchens(names: list[str]) -> list[str]:
