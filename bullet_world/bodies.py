@@ -33,6 +33,7 @@ class PlacedObject:
     draw: dict
     xy: np.ndarray
     yaw: float
+    texture: str = ""   # the generated texture PNG the body is drawn with (the viewer shows it too)
 
     @property
     def look(self) -> KindState:
@@ -62,14 +63,15 @@ class BodyBuilder:
         self.client, self.cache = client, str(cache_dir(cache))
         self._textures: dict[str, int] = {}
         self._collisions: dict[tuple, int] = {}
-        self._looks: dict[tuple, tuple[str, int]] = {}
+        self._looks: dict[tuple, tuple[str, int, str]] = {}
 
-    def _texture(self, kind: ObjectKind, look: KindState, index: int) -> int:
+    def _texture(self, kind: ObjectKind, look: KindState, index: int) -> tuple[int, str]:
+        """The loaded texture's id and its PNG file."""
         seed = zlib.crc32(f"{kind.name}/{look.name}".encode())
         path = texture_file(look.texture, look.colours[index], look.inner_colour, seed, self.cache)
         if path not in self._textures:
             self._textures[path] = p.loadTexture(path, physicsClientId=self.client)
-        return self._textures[path]
+        return self._textures[path], str(path)
 
     def _collision(self, look: KindState, size: tuple[float, float, float]) -> int:
         shape = {"box": "box", "bag": "box", "slices": "box", "sphere": "sphere"}.get(look.shape, "cylinder")
@@ -96,8 +98,8 @@ class BodyBuilder:
         tint = np.clip(np.asarray(draw["colour"], dtype=float) / base, 0.0, 1.0)
         key = (kind.name, look.name, index)
         if key not in self._looks:  # the mesh file and texture of this kind state and base colour
-            self._looks[key] = (mesh_file(look, self.cache), self._texture(kind, look, index))
-        mesh, texture = self._looks[key]
+            self._looks[key] = (mesh_file(look, self.cache), *self._texture(kind, look, index))
+        mesh, texture, texture_path = self._looks[key]
         visual = p.createVisualShape(p.GEOM_MESH, fileName=mesh, meshScale=list(size),
                                      rgbaColor=[*tint.tolist(), 1.0], physicsClientId=self.client)
         position = [float(xy[0]), float(xy[1]), size[2] / 2]
@@ -107,7 +109,7 @@ class BodyBuilder:
         if look.shape not in ("box", "bag", "slices"):
             p.changeDynamics(body, -1, rollingFriction=ROLLING_FRICTION, spinningFriction=ROLLING_FRICTION,
                              physicsClientId=self.client)
-        return PlacedObject(body, kind, draw, np.asarray(xy, dtype=float)[:2].copy(), float(yaw))
+        return PlacedObject(body, kind, draw, np.asarray(xy, dtype=float)[:2].copy(), float(yaw), texture_path)
 
 
 def outline(kind: ObjectKind, draw: dict) -> tuple[str, float, float]:

@@ -290,6 +290,13 @@ class Viewer:
                 self.on_answer(record.get("action", {}), record.get("answer", {}), scene)
         self._asked_this_turn = False
 
+    def caption(self, text: str, detail: str = "", marked: int | None = None, dwell_s: float = 0.0) -> None:
+        """Outside a dialog (a recipe's demonstrations and execution): show ``text`` and ``detail`` in the
+        scene and mark object ``marked`` (0-based, the world's order) as the one the robot means."""
+        self.question, self.answer = str(text), str(detail)
+        self.asked, self.shown = marked, None
+        self.update(dwell_s)
+
     # -- export and shutdown ----------------------------------------------------------
     def export_html(self, path: str | Path, title: str = "teachbot episode") -> dict:
         """Write everything recorded so far as one static HTML page (meshcat animation, no server)."""

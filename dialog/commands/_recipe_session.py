@@ -3,7 +3,7 @@
 The glue between ``bullet_world.recipe_world`` (scenes, the scripted teacher,
 observations), ``learning.demonstration`` (eq. 4.1-4.3, GMM parameter models)
 and ``robot.pick_place`` (grasp, carry, place). Used by ``teachbot recipe``,
-``scripts/recipe_experiments.py`` and the tests.
+``dialog/regress/recipe_study.py`` (the chapter-4 experiments) and the tests.
 
 * ``action_observations``: one demonstration as the learner's input; the rows
   of each "after" observation are matched to the "before" rows from perceived
@@ -17,7 +17,7 @@ and ``robot.pick_place`` (grasp, carry, place). Used by ``teachbot recipe``,
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -35,6 +35,25 @@ PLACE_TAU = 2.0            # put-down spots lie this close (Mahalanobis) to the 
 PLACE_SUPPORT_M = 0.03     # ... and this close to a spot where the teacher put something down
 PLACE_GAP_M = 0.01         # free space kept around other perceived objects
 HAND_RADIUS_M = 0.035      # the opening fingers sweep about this radius around the object's centre
+
+# narrate(text, detail, body): tells a watcher (the viewer) what happens; body is the object meant, or None.
+Narrate = Callable[[str, str, "int | None"], None]
+
+
+class NarratedRecipeWorld(RecipeWorld):
+    """A ``RecipeWorld`` that tells ``narrate`` (when set) which demonstration the teacher gives.
+
+    It only reports: the demonstrations, their random draws and observations are those of ``RecipeWorld``.
+    """
+
+    narrate: Narrate | None = None
+
+    def demonstrate_once(self, number: int, layout: int, arrangement, lighting: str,
+                         rng: np.random.Generator) -> RecipeDemonstration:
+        if self.narrate is not None:
+            steps = "; ".join(f"{obj}: {start} -> {end}" for obj, start, end in self.steps)
+            self.narrate(f"Teacher: demonstration {number} (arrangement {layout + 1}, {lighting} light)", steps, None)
+        return super().demonstrate_once(number, layout, arrangement, lighting, rng)
 
 
 def recipe_steps(recipe: Recipe) -> list[tuple[str, str, str]]:
@@ -189,8 +208,13 @@ def _free(model: ParameterModel, candidates: np.ndarray, recipe_world: RecipeWor
 
 
 def execute_recipe(grounding: RecipeGrounding, recipe: Recipe, recipe_world: RecipeWorld,
-                   manipulator: Manipulator, rng: np.random.Generator, tau: float = DEFAULT_TAU) -> list[StepOutcome]:
-    """Carry the recipe out in the current scene (thesis §4.2.4, then a real pick-place per step)."""
+                   manipulator: Manipulator, rng: np.random.Generator, tau: float = DEFAULT_TAU,
+                   narrate: Narrate | None = None) -> list[StepOutcome]:
+    """Carry the recipe out in the current scene (thesis §4.2.4, then a real pick-place per step).
+
+    ``narrate``, when given, hears each step's choice before the arm moves and its outcome after.
+    """
+    narrate = narrate or (lambda text, detail, body: None)
     outcomes = []
     demonstrated = [actions for actions in grounding.demonstrated_actions if len(actions) == len(recipe.steps)]
     plans: dict[int, np.ndarray] = {}
@@ -199,6 +223,7 @@ def execute_recipe(grounding: RecipeGrounding, recipe: Recipe, recipe_world: Rec
         choice = grounding.choose_object(step, observation.appearance, observation.locations, tau=tau)
         if not choice.found:
             outcomes.append(StepOutcome(step, choice.status, choice.reason, None, False, False, None))
+            narrate(f"Robot: {step}", choice.reason, None)
             continue
         row = choice.index
         kind, role, body = (observation.truth.kinds[row], observation.truth.roles[row],
@@ -215,14 +240,17 @@ def execute_recipe(grounding: RecipeGrounding, recipe: Recipe, recipe_world: Rec
         if place is None:
             outcomes.append(StepOutcome(step, "no-free-place", f"no free spot at {step.end!r} for the object",
                                         kind, role == step.object, False, None))
+            narrate(f"Robot: {step}", f"no free spot at {step.end!r}", body)
             continue
         target = GraspTarget.from_measurement(observation.measurements[row])
         place_xy = recipe_world.to_world_frame(place)[0, :2]
         obstacles = [Obstacle.from_measurement(m) for i, m in enumerate(observation.measurements) if i != row]
+        narrate(f"Robot: {step}", choice.reason, body)
         result = manipulator.pick_place(target, place_xy, ModelRegion(end_model, recipe_world, tau), obstacles)
         true_xy = recipe_world.true_position(body)[:2]
         in_region = recipe_world.region(step.end).contains(true_xy)
         status = "done" if result.success else result.reason
         explanation = choice.reason + ("; placed" if result.success else f"; {result.reason}: {result.detail}")
         outcomes.append(StepOutcome(step, status, explanation, kind, role == step.object, in_region, result))
+        narrate(f"Robot: {step}", "placed" if result.success else f"{result.reason}: {result.detail}", body)
     return outcomes

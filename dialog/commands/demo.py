@@ -8,6 +8,7 @@ from dataclasses import asdict
 from pathlib import Path
 
 from dialog.commands._arguments import add_episode_options
+from dialog.commands._viewer import add_viewer_option, viewer_observers
 from dialog.environment import SimulatedKitchen
 from dialog.manager import DialogManager, EpisodeConfig, episode_generators
 from dialog.teachers import OracleTeacher
@@ -22,6 +23,7 @@ def register(commands) -> None:
     add_episode_options(parser, STRATEGY_NAMES, "active")
     parser.add_argument("--transcript", type=Path, default=None,
                         help="transcript path (default runs/demo-<strategy>-seed<seed>.jsonl)")
+    add_viewer_option(parser)
     parser.add_argument("--json", action="store_true", help="end with one JSON line summarising the episode")
     parser.set_defaults(handler=run)
 
@@ -32,9 +34,9 @@ def run(args: argparse.Namespace) -> int:
     transcript_path = args.transcript or Path("runs") / f"demo-{args.strategy}-seed{args.seed}.jsonl"
     environment = SimulatedKitchen(task=args.task, kitchen=args.kitchen, seed=args.seed)
     try:
-        with TranscriptWriter(transcript_path) as transcript:
+        with viewer_observers(args, environment.world) as observers, TranscriptWriter(transcript_path) as transcript:
             manager = DialogManager(environment, OracleTeacher(rngs["teacher"]), make_strategy(args.strategy),
-                                    config, transcript, rngs)
+                                    config, transcript, rngs, observers=observers)
             result = manager.run()
     finally:
         environment.close()

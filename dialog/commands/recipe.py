@@ -22,15 +22,23 @@ import time
 import numpy as np
 from threadpoolctl import threadpool_limits
 
-from bullet_world.recipe_world import RecipeWorld
 from dialog.commands._arguments import positive_int
-from dialog.commands._recipe_session import StepOutcome, execute_recipe, ground, parameter_names, recipe_steps
+from dialog.commands._recipe_session import (
+    NarratedRecipeWorld,
+    StepOutcome,
+    execute_recipe,
+    ground,
+    parameter_names,
+    recipe_steps,
+)
 from dialog.commands._viewer import add_viewer_option, start_viewer, stop_viewer
 from learning.demonstration import DEFAULT_TAU, RecipeGrounding
 from learning.recipe import Recipe, builtin_recipe_names, load_builtin_recipe, load_recipe
 from robot import Arm
 from robot.grasping import GRASP_MODES
 from robot.pick_place import Manipulator
+
+CAPTION_DWELL_S = 1.5  # seconds each caption holds in an exported page (--viewer-export)
 
 
 def register(commands) -> None:
@@ -79,39 +87,57 @@ def run(args: argparse.Namespace) -> int:
     recipe = load_any_recipe(args.recipe)
     rng = np.random.default_rng(args.seed)
     with threadpool_limits(limits=1, user_api="blas"), \
-            RecipeWorld(recipe_steps(recipe), task=args.task or recipe.name, kitchen=args.kitchen,
-                        seed=args.seed) as world:
+            NarratedRecipeWorld(recipe_steps(recipe), task=args.task or recipe.name, kitchen=args.kitchen,
+                                seed=args.seed) as world:
         viewer = start_viewer(args, world.world)
-        if viewer is not None:
-            viewer.start_recording()
-        print(f"Recipe {recipe.name} in {world.kitchen.name} (household {world.household.name}): "
-              + "; ".join(str(step) for step in recipe.steps))
-        demonstrations = world.demonstrate(args.demos, rng)
-        grounding = ground(recipe, demonstrations, rng)
-        parsed_right = _print_demonstrations(recipe, demonstrations, grounding)
-        _print_models(recipe, grounding)
-        summary = {"recipe": recipe.name, "kitchen": world.kitchen.name, "demos": args.demos, "seed": args.seed,
-                   "moved_object_found": parsed_right, "parameters": _model_summary(recipe, grounding)}
-        if args.execute:
-            arm = Arm(world.world)
-            manipulator = Manipulator(arm, args.grasp)
-            try:
-                world.set_lighting(args.lighting or next(iter(world.setup.lighting)))
-                world.arrange(world.new_arrangement(rng))
-                print(f"\nExecution in a new arrangement under {world.lighting_name} lighting:")
-                outcomes = execute_recipe(grounding, recipe, world, manipulator, rng, args.tau)
-            finally:
-                manipulator.close()
-                if viewer is not None:
-                    viewer.update(dwell_s=2.0)
-            _print_outcomes(outcomes)
-            summary["steps"] = [_outcome_summary(outcome) for outcome in outcomes]
-            summary["success"] = all(outcome.success for outcome in outcomes)
-        summary["seconds"] = round(time.perf_counter() - started, 1)
-        stop_viewer(viewer)
+        try:
+            if viewer is not None:
+                viewer.start_recording()
+                world.narrate = _narrator(viewer, world)
+            summary = _session(args, recipe, world, rng, world.narrate)
+        finally:
+            stop_viewer(viewer)
+    summary["seconds"] = round(time.perf_counter() - started, 1)
     if args.json:
         print(json.dumps(summary))
     return 0
+
+
+def _session(args: argparse.Namespace, recipe: Recipe, world: NarratedRecipeWorld, rng: np.random.Generator,
+             narrate) -> dict:
+    """Demonstrations, grounding and (with --execute) the arm carrying the recipe out; the JSON summary."""
+    print(f"Recipe {recipe.name} in {world.kitchen.name} (household {world.household.name}): "
+          + "; ".join(str(step) for step in recipe.steps))
+    demonstrations = world.demonstrate(args.demos, rng)
+    grounding = ground(recipe, demonstrations, rng)
+    parsed_right = _print_demonstrations(recipe, demonstrations, grounding)
+    _print_models(recipe, grounding)
+    summary = {"recipe": recipe.name, "kitchen": world.kitchen.name, "demos": args.demos, "seed": args.seed,
+               "moved_object_found": parsed_right, "parameters": _model_summary(recipe, grounding)}
+    if args.execute:
+        manipulator = Manipulator(Arm(world.world), args.grasp)
+        try:
+            world.set_lighting(args.lighting or next(iter(world.setup.lighting)))
+            world.arrange(world.new_arrangement(rng))
+            print(f"\nExecution in a new arrangement under {world.lighting_name} lighting:")
+            outcomes = execute_recipe(grounding, recipe, world, manipulator, rng, args.tau, narrate=narrate)
+        finally:
+            manipulator.close()
+        _print_outcomes(outcomes)
+        summary["steps"] = [_outcome_summary(outcome) for outcome in outcomes]
+        summary["success"] = all(outcome.success for outcome in outcomes)
+        if narrate is not None:
+            done = sum(outcome.success for outcome in outcomes)
+            narrate(f"Robot: {recipe.name} done", f"{done} of {len(outcomes)} steps carried out correctly", None)
+    return summary
+
+
+def _narrator(viewer, world: NarratedRecipeWorld):
+    """Captions in the viewer; the object meant is marked (its number in the world's order)."""
+    def narrate(text: str, detail: str = "", body: int | None = None) -> None:
+        bodies = world.world.object_bodies
+        viewer.caption(text, detail, bodies.index(body) if body in bodies else None, dwell_s=CAPTION_DWELL_S)
+    return narrate
 
 
 def _print_demonstrations(recipe: Recipe, demonstrations, grounding: RecipeGrounding) -> str:

@@ -8,6 +8,7 @@ import sys
 from pathlib import Path
 
 from dialog.commands._arguments import add_episode_options, budget
+from dialog.commands._viewer import add_viewer_option, start_viewer, stop_viewer
 from dialog.environment import SimulatedKitchen
 from dialog.session import SessionSettings, open_session
 from dialog.transcript import read_session
@@ -64,6 +65,7 @@ def register(commands) -> None:
     parser.add_argument("--no-pictures", action="store_true", help="write no scene pictures")
     parser.add_argument("--no-fetch", action="store_true",
                         help="never fetch an absent example from the pantry")
+    add_viewer_option(parser)
     parser.add_argument("--json", action="store_true", help="end with one JSON line summarising the session")
     parser.set_defaults(handler=run)
 
@@ -109,10 +111,13 @@ def run(args: argparse.Namespace, input_stream=None, output_stream=None) -> int:
     out = output_stream or sys.stdout
     environment = SimulatedKitchen(task=settings.task, kitchen=settings.kitchen, seed=settings.seed,
                                    pictures=pictures is not None)
+    viewer = None
     try:
+        viewer = start_viewer(args, environment.world)
         manager, records = open_session(settings, environment, path, resume=args.resume is not None,
                                         pictures=None if pictures is None else str(pictures),
-                                        input_stream=input_stream, output_stream=out, say=None)
+                                        input_stream=input_stream, output_stream=out, say=None,
+                                        observers=() if viewer is None else (viewer,))
         manager.say = _narrator(manager.teacher, out, person)
         intro = (f"Teaching '{settings.task}' ({', '.join(environment.concepts)}) in {settings.kitchen}: "
                  f"{settings.turns} turns, budget {settings.budget:g}, strategy {settings.strategy}. "
@@ -130,6 +135,7 @@ def run(args: argparse.Namespace, input_stream=None, output_stream=None) -> int:
         finally:
             manager.transcript.close()
     finally:
+        stop_viewer(viewer)
         environment.close()
     if manager.replay_mismatches:
         manager.say(f"(note: on {manager.replay_mismatches} replayed turn(s) the strategy would now ask something "
