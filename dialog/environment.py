@@ -58,6 +58,7 @@ class SimulatedKitchen:
         self.test_scenes = self.world.task.test_scenes
         self.pictures = pictures
         self._scene_image = None  # (scene id, rgb, pixel position of every object)
+        self._arm_out = False  # the arm pointed since the last scene: rest it before the world is observed again
 
     @property
     def locations(self) -> dict:
@@ -73,6 +74,9 @@ class SimulatedKitchen:
         """The world changes: objects move on to their next state where the task has states (prepare
         lunch), else (or once every state is reached) a fresh sample of objects."""
         world = self.world
+        if self._arm_out:  # a pointing arm left in the camera's view would hide objects of the next observation
+            self.arm.rest()
+            self._arm_out = False
         last_stage = max((len(getattr(k, "states", ())) for k in getattr(world, "kinds", ())), default=0) - 1
         if getattr(world.task, "has_states", False) and world.scene is not None and world.stage < last_stage:
             scene = world.advance_states(rng)
@@ -88,6 +92,7 @@ class SimulatedKitchen:
     def point_at(self, scene: Scene, object_index: int) -> dict:
         """Really move the arm; report where the fingertip ended relative to the object."""
         result = point_at(self.arm, scene.positions[object_index], scene.tops[object_index])
+        self._arm_out = True
         tip = self.arm.fingertip_position()
         offset = tip - scene.truth.positions[object_index]
         return {"reached": result.reached, "horizontal_error_m": round(float(np.hypot(*offset[:2])), 4),
