@@ -30,6 +30,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import torch
+import torch.nn.functional as F
 from scipy.optimize import minimize
 from threadpoolctl import threadpool_limits
 
@@ -37,6 +38,7 @@ from learning.irl_data import QuestioningEpisode, common_feature_names
 from learning.irl_weights import DecisionWeights
 
 OPTIMIZERS = ("lbfgs", "adam")
+POLICIES = ("softmax", "gated")
 SELECTION_CRITERIA = ("agreement", "log_likelihood")
 
 
@@ -53,6 +55,7 @@ class IrlConfig:
     seed: int = 0
     threads: int = 1  # torch and BLAS threads during the fit; the arrays are tiny, more threads only contend
     select_by: str = "agreement"  # keep the iterate best on validation by "agreement" or "log_likelihood"
+    policy: str = "softmax"  # "softmax" over all candidates, or "gated": ask-or-not, then which query (see below)
 
     def __post_init__(self) -> None:
         if isinstance(self.max_iterations, bool) or not isinstance(self.max_iterations, int) \
@@ -66,6 +69,8 @@ class IrlConfig:
                 raise ValueError(f"{name} must be a finite number >= 0, got {value!r}")
         if isinstance(self.threads, bool) or not isinstance(self.threads, int) or self.threads < 1:
             raise ValueError(f"threads must be an integer >= 1, got {self.threads!r}")
+        if self.policy not in POLICIES:
+            raise ValueError(f"unknown policy {self.policy!r}; accepted: {', '.join(POLICIES)}")
         if self.select_by not in SELECTION_CRITERIA:
             raise ValueError(f"unknown select_by {self.select_by!r}; accepted: {', '.join(SELECTION_CRITERIA)}")
         if self.optimizer == "adam" and self.learning_rate <= 0:
@@ -116,19 +121,49 @@ class PaddedTurns:
 
 
 class _TorchTurns:
-    """PaddedTurns as float64 tensors, with the log-likelihood of eq. 7.5-7.7."""
+    """PaddedTurns as float64 tensors, with the log-likelihood of eq. 7.5-7.7 (softmax) or its gated form.
 
-    def __init__(self, turns: PaddedTurns, scale: np.ndarray, identifiable: np.ndarray | None = None):
+    The gated policy follows the DT's own two-step rule (thesis §6.4, §7.3.1: take the best query a* only
+    if EU(a*) > U(s)). Whether to ask is a logistic choice between no query and a smooth maximum of the
+    query utilities, their log-mean-exp, which unlike the softmax's log-sum-exp does not grow with the
+    number of near-identical label queries; which query is then the softmax over the queries:
+
+        P(ask) = sigmoid(LME_q(w . Phi[q]) - w . Phi[NQ]),   P(q | ask) = softmax_q(w . Phi[q]).
+
+    With a dozen label queries that look alike, the plain softmax can explain an expert who asks on half
+    the turns only by making each single query less attractive than silence, so the greedy DT never asks.
+    Turns without a no-query candidate use the softmax.
+    """
+
+    def __init__(self, turns: PaddedTurns, scale: np.ndarray, identifiable: np.ndarray | None = None,
+                 policy: str = "softmax"):
         keep = np.ones_like(scale) if identifiable is None else identifiable.astype(np.float64)
         self.phi = torch.from_numpy(turns.phi * (keep / scale))  # an unidentifiable column gets no gradient
         self.pad = torch.from_numpy(~turns.valid)
         self.chosen = torch.from_numpy(turns.chosen)
+        self.policy = policy
+        rows = np.arange(len(turns))
+        has_nq = turns.no_query >= 0
+        query = turns.valid.copy()
+        query[rows[has_nq], turns.no_query[has_nq]] = False
+        self.gated = torch.from_numpy(has_nq & (query.sum(axis=1) > 0))
+        self.no_query = torch.from_numpy(np.maximum(turns.no_query, 0))
+        self.not_query = torch.from_numpy(~query)
+        self.log_queries = torch.from_numpy(np.log(np.maximum(query.sum(axis=1), 1)).astype(np.float64))
+        self.quiet = torch.from_numpy(turns.chosen == turns.no_query)
 
     def mean_log_likelihood(self, v: torch.Tensor) -> torch.Tensor:
-        """(1/N) sum_t [v . Phi_t[a_t] - log sum_b exp(v . Phi_t[b])]."""
+        """Softmax: (1/N) sum_t [v . Phi_t[a_t] - log sum_b exp(v . Phi_t[b])]; gated: see the class."""
         utilities = (self.phi @ v).masked_fill(self.pad, -torch.inf)
-        log_policy = utilities - torch.logsumexp(utilities, dim=1, keepdim=True)
-        return log_policy.gather(1, self.chosen[:, None]).mean()
+        chosen = utilities.gather(1, self.chosen[:, None])[:, 0]
+        softmax = chosen - torch.logsumexp(utilities, dim=1)
+        if self.policy == "softmax":
+            return softmax.mean()
+        queries = torch.logsumexp(utilities.masked_fill(self.not_query, -torch.inf), dim=1)
+        ask = queries - self.log_queries - utilities.gather(1, self.no_query[:, None])[:, 0]
+        ask = torch.where(self.gated, ask, torch.zeros_like(ask))  # keep the unused branch finite
+        gated = torch.where(self.quiet, F.logsigmoid(-ask), F.logsigmoid(ask) + chosen - queries)
+        return torch.where(self.gated, gated, softmax).mean()
 
 
 class AdamAscent:
@@ -240,8 +275,8 @@ def _fit_per_turn(train, validation, config: IrlConfig, initial_weights) -> IrlR
     w0 = np.zeros(len(names)) if initial_weights is None else np.asarray(initial_weights, dtype=np.float64)
     if w0.shape != (len(names),) or not np.all(np.isfinite(w0)):
         raise ValueError(f"initial_weights must be {len(names)} finite numbers, got shape {w0.shape}")
-    data = _TorchTurns(train_turns, scale, identifiable)
-    held_out = _TorchTurns(validation_turns, scale) if validation_turns is not None else None
+    data = _TorchTurns(train_turns, scale, identifiable, config.policy)
+    held_out = _TorchTurns(validation_turns, scale, policy=config.policy) if validation_turns is not None else None
     penalised = identifiable.astype(np.float64)
 
     def value_and_gradient(x: np.ndarray) -> tuple[float, np.ndarray]:
@@ -288,8 +323,8 @@ def _fit_per_turn(train, validation, config: IrlConfig, initial_weights) -> IrlR
                 break
         iterations = len(history) - 1
     best_w, best_iteration = best["w"], best["iteration"]
-    settings = {"method": "maxent-irl-per-turn", "optimizer": config.optimizer, "l2": float(config.l2),
-                "select_by": config.select_by}
+    settings = {"method": "maxent-irl-per-turn", "policy": config.policy, "optimizer": config.optimizer,
+                "l2": float(config.l2), "select_by": config.select_by}
     return make_result(names, best_w, identifiable, history, best_iteration, iterations, converged, settings,
                        train_turns, validation_turns, started)
 

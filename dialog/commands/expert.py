@@ -1,0 +1,91 @@
+"""``teachbot expert``: play the robot's questioner; every turn is saved as an IRL demonstration (thesis §7.3.2)."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+from dialog.commands._arguments import budget, positive_int
+from learning.actions import DEFAULT_COSTS
+
+COST_NAMES = {"lq": "label", "label": "label", "dq": "demo", "demo": "demo", "fsq": "feature", "feature": "feature",
+              "nq": "none", "none": "none"}
+
+
+def costs(text: str) -> dict:
+    """'DQ=2,FSQ=2,LQ=1,NQ=0' (any of LQ/DQ/FSQ/NQ or label/demo/feature/none; missing ones keep the default)."""
+    table = dict(DEFAULT_COSTS)
+    for part in filter(None, (p.strip() for p in text.split(","))):
+        name, _, value = part.partition("=")
+        kind = COST_NAMES.get(name.strip().lower())
+        if kind is None or not value:
+            raise argparse.ArgumentTypeError(f"'{part}': expected NAME=NUMBER with NAME one of LQ, DQ, FSQ, NQ")
+        table[kind] = budget(value.strip())
+    return table
+
+
+def register(commands) -> None:
+    parser = commands.add_parser(
+        "expert", help="play the robot's questioner: pick its questions; the turns become IRL demonstrations",
+        description="Each turn shows the scene and every candidate question with its cost and its seven expected "
+                    "decision features; you pick one (LQ 4, DQ fruit, FSQ, none; help, quit) and a scripted teacher "
+                    "answers. Defaults are the thesis's training condition (§7.4.1).")
+    parser.add_argument("--task", default="prepare-lunch", help="task (default prepare-lunch)")
+    parser.add_argument("--kitchen", default="kitchen-1", help="kitchen (default kitchen-1)")
+    parser.add_argument("--budget", type=budget, default=15.0, help="query budget (default 15)")
+    parser.add_argument("--turns", type=positive_int, default=30, help="turns (default 30)")
+    parser.add_argument("--change-every", type=positive_int, default=10, help="a new scene every r turns (default 10)")
+    parser.add_argument("--costs", type=costs, default=dict(DEFAULT_COSTS), metavar="DQ=2,FSQ=2,LQ=1,NQ=0",
+                        help="query costs (default DQ 2, FSQ 2, LQ 1, NQ 0)")
+    parser.add_argument("--seed", type=int, default=0, help="one seed for every random choice (default 0)")
+    parser.add_argument("--out", type=Path, default=Path("runs") / "expert", metavar="DIR",
+                        help="directory for the demonstration (.json) and the transcript (.jsonl)")
+    parser.add_argument("--expert", choices=("person", "scripted"), default="person",
+                        help="who chooses: you (default) or the scripted expert")
+    parser.add_argument("--json", action="store_true", help="end with one JSON line summarising the episode")
+    parser.set_defaults(handler=run)
+
+
+def run(args: argparse.Namespace, input_stream=None, output_stream=None) -> int:
+    from dialog.environment import SimulatedKitchen
+    from dialog.expert import ExpertQuit, ExpertSettings, output_paths, run_expert_episode
+    from dialog.expert_terminal import PersonChooser
+    from dialog.scripted_expert import ScriptedExpertChooser
+
+    out = output_stream or sys.stdout
+    settings = ExpertSettings(task=args.task, kitchen=args.kitchen, budget=args.budget, turns=args.turns,
+                              change_every=args.change_every, seed=args.seed, costs=args.costs)
+    settings.config()  # check the allocation before building the kitchen
+    chooser_name = "person" if args.expert == "person" else ScriptedExpertChooser.name
+    output_paths(args.out, settings.name(chooser_name))
+    environment = SimulatedKitchen(task=settings.task, kitchen=settings.kitchen, seed=settings.seed)
+    try:
+        if args.expert == "person":
+            chooser = PersonChooser(input_stream, out, environment.locations)
+            say, observers = chooser.say, (chooser,)
+            say(f"Expert mode: '{settings.task}' ({', '.join(environment.concepts)}) in {settings.kitchen}, "
+                f"{settings.turns} turns, budget {settings.budget:g}, a new scene every {settings.change_every}. "
+                "You choose the robot's questions; a scripted teacher answers. Type 'help' for the commands.")
+        else:
+            chooser = ScriptedExpertChooser()
+            say, observers = (lambda text: print(text, file=out, flush=True)), ()
+        try:
+            outcome = run_expert_episode(settings, chooser, args.out, environment, say=say, observers=observers)
+        except ExpertQuit as stop:
+            print(f"Nothing saved: {stop}", file=out, flush=True)
+            return 0
+    finally:
+        environment.close()
+    result = outcome.result
+    print(f"{'Stopped' if result.quit else 'Done'} after {len(outcome.episode.turns)} turns: accuracy "
+          f"{result.accuracy:.1%}, budget spent {result.budget_spent:g} of {settings.budget:g}, queries "
+          f"{result.queries}. Demonstration: {outcome.demonstration}; transcript: {outcome.transcript}",
+          file=out, flush=True)
+    if args.json:
+        print(json.dumps({"seed": settings.seed, "expert": chooser.name, "turns": len(outcome.episode.turns),
+                          "quit": result.quit, "budget_spent": result.budget_spent, "queries": result.queries,
+                          "accuracy": round(result.accuracy, 6), "demonstration": str(outcome.demonstration),
+                          "transcript": str(outcome.transcript)}), file=out, flush=True)
+    return 0

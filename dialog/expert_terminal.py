@@ -1,0 +1,155 @@
+"""The person at the terminal in expert mode: the scene, the candidates with their features, one command a turn.
+
+Commands (case does not matter): ``LQ 4`` (or just ``4``) label object 4; ``DQ fruit`` (or ``DQ 3``) ask for
+a demonstration; ``FSQ`` the feature query; ``none`` stay quiet; ``table`` show the scene again; ``help``;
+``quit`` (or end of input) ends the session, keeping the turns so far.
+"""
+
+from __future__ import annotations
+
+import sys
+
+from rich.console import Console
+from rich.table import Table
+
+from dialog.describe import SceneDescriber
+from dialog.expert import ExpertQuit, ExpertView, action_label
+from dialog.terminal import LineReader
+from learning.actions import Action, DemoQuery, FeatureQuery, LabelQuery, NoQuery
+from learning.decision_features import label_distribution
+
+SHORT_NAMES = ("ACD", "CDU", "IV", "PM", "budget", "time", "quiet")  # FEATURE_NAMES order
+HELP = ("Type one of: LQ <object number> (or just the number), DQ <concept name or number>, FSQ, none, "
+        "table (the scene again), help, quit.")
+
+
+class ExpertInputError(ValueError):
+    """A command that cannot be taken this turn; the message says what is accepted."""
+
+
+def parse_command(text: str, view: ExpertView) -> Action | str:
+    """The action a typed line names, or "help" / "table" / "quit"; ExpertInputError for anything else."""
+    words = text.strip().lower().split()
+    if not words:
+        raise ExpertInputError(f"Nothing typed. {HELP}")
+    head, rest = words[0], " ".join(words[1:])
+    if head in ("help", "?", "h"):
+        return "help"
+    if head in ("table", "scene"):
+        return "table"
+    if head in ("quit", "exit", "q"):
+        return "quit"
+    candidates = view.candidates.actions
+    if head in ("none", "nq", "quiet", "nothing"):
+        return NoQuery()
+    if head in ("fsq", "feature", "features"):
+        if FeatureQuery() not in candidates:
+            why = "it was already asked" if view.state.feature_query_asked else "the budget left does not cover it"
+            raise ExpertInputError(f"FSQ is not available: {why}.")
+        return FeatureQuery()
+    if head.isdigit() or head in ("lq", "label"):
+        number = head if head.isdigit() else rest
+        if not number.isdigit():
+            raise ExpertInputError(f"'{text.strip()}': give the object's number, e.g. LQ 4.")
+        index, n_objects = int(number) - 1, len(view.state.scene_X)
+        if not 0 <= index < n_objects:
+            raise ExpertInputError(f"There is no object {number}; this scene has objects 1 to {n_objects}.")
+        if LabelQuery(index) not in candidates:
+            why = ("it is already labelled in this scene" if index in view.state.labelled_in_scene
+                   else "the budget left does not cover a label query")
+            raise ExpertInputError(f"LQ {number} is not available: {why}.")
+        return LabelQuery(index)
+    if head in ("dq", "demo"):
+        concepts = view.state.concepts
+        if rest.isdigit() and 1 <= int(rest) <= len(concepts):
+            concept = concepts[int(rest) - 1]
+        else:
+            matches = [c for c in concepts if c.startswith(rest)] if rest else []
+            if len(matches) != 1:
+                raise ExpertInputError(f"'{text.strip()}': name one concept: {', '.join(concepts)} (or 1 to "
+                                       f"{len(concepts)}).")
+            concept = matches[0]
+        if DemoQuery(concept) not in candidates:
+            raise ExpertInputError(f"DQ {concept} is not available: the teacher could not show one in this scene or "
+                                   "the budget left does not cover it.")
+        return DemoQuery(concept)
+    raise ExpertInputError(f"'{text.strip()}' is not a command. {HELP}")
+
+
+class PersonChooser:
+    """Shows the scene and the candidates table, reads one command per turn from injected streams."""
+
+    name = "person"
+
+    def __init__(self, input_stream=None, output_stream=None, locations: dict | None = None):
+        self.reader = LineReader(input_stream if input_stream is not None else sys.stdin)
+        self.console = Console(file=output_stream if output_stream is not None else sys.stdout, highlight=False,
+                               markup=False, emoji=False, soft_wrap=False, width=160)
+        self.locations = locations or {}
+        self.scene = None
+
+    def say(self, text: str) -> None:
+        self.console.print(text)
+
+    def on_scene(self, scene) -> None:
+        self.scene = scene
+        self.show_scene()
+
+    def show_scene(self) -> None:
+        if self.scene is not None:
+            for line in SceneDescriber(self.scene, self.locations).table_lines():
+                self.console.print(f"  {line}")
+
+    def table(self, view: ExpertView) -> Table:
+        """Every candidate: its command, cost and the seven expected decision features (queries as change
+        against staying quiet)."""
+        candidates, state = view.candidates, view.state
+        table = Table(title=f"Turn {view.turn} of {state.turns} · budget left {state.remaining_budget:g} of "
+                            f"{state.budget:g} · query rows: change of E[phi] against staying quiet",
+                      title_justify="left", pad_edge=False)
+        for column in ("type", "action", "robot's guess", "cost", *SHORT_NAMES):
+            table.add_column(column, justify="right" if column in ("cost", *SHORT_NAMES) else "left")
+        quiet = candidates.expected[candidates.no_query_index]
+        Q = label_distribution(state.probabilities()) if len(state.scene_X) else None
+        describer = SceneDescriber(self.scene, self.locations) if self.scene is not None else None
+        for row, action in zip(candidates.expected, candidates.actions):
+            guess = ""
+            if action.kind == "label":
+                command = f"LQ {action.object_index + 1}"
+                top = int(Q[action.object_index].argmax())
+                guess = f"{state.concepts[top]} {Q[action.object_index, top]:.2f}"
+                what = describer.describe(action.object_index) if describer else action_label(action)
+            elif action.kind == "demo":
+                command, what = f"DQ {action.concept}", f"show me a {action.concept}"
+            elif action.kind == "feature":
+                command, what = "FSQ", "which features matter?"
+            else:
+                command, what = "none", "stay quiet"
+            values = row if action.kind == "none" else row - quiet
+            cells = [f"{v:.3f}" if action.kind == "none" else f"{v:+.3f}" for v in values]
+            table.add_row(command, what, guess, f"{state.cost(action):g}", *cells)
+        return table
+
+    def choose(self, view: ExpertView) -> Action:
+        self.console.print(self.table(view))
+        while True:
+            self.console.print("expert> ", end="")
+            self.console.file.flush()
+            line = self.reader.readline()
+            if line is None:
+                self.console.print()
+                raise ExpertQuit("end of input")
+            try:
+                choice = parse_command(line, view)
+            except ExpertInputError as error:
+                self.console.print(str(error))
+                continue
+            if choice == "help":
+                self.console.print(HELP)
+            elif choice == "table":
+                self.show_scene()
+                self.console.print(self.table(view))
+            elif choice == "quit":
+                raise ExpertQuit("quit")
+            else:
+                return choice

@@ -1,0 +1,53 @@
+"""`teachbot learn-weights` on the shipped scripted-expert demonstrations; bad input; the shipped learned file."""
+
+import json
+
+import numpy as np
+
+from dialog.cli import main
+from learning.decision_features import FEATURE_NAMES
+from learning.decision_weights import WEIGHTS_DIRECTORY, load_weight_file
+from learning.irl_weights import load_weights
+
+LEARNED = WEIGHTS_DIRECTORY / "dt-task-env.toml"  # the dt-task-env preset carries the learned weights
+
+
+def test_learn_weights_on_the_shipped_demos_prints_the_summary_and_reproduces_the_shipped_file(tmp_path, capsys):
+    out = tmp_path / "w.toml"
+    assert main(["learn-weights", "--demos", "shipped", "--out", str(out), "--json"]) == 0
+    summary = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
+    assert set(summary) == {"iterations", "seconds", "weights", "validation_agreement"}
+    assert 0.0 <= summary["validation_agreement"] <= 1.0 and 1 <= summary["iterations"] <= 100
+    assert list(summary["weights"]) == list(FEATURE_NAMES)
+    np.testing.assert_array_equal(load_weight_file(out), [summary["weights"][n] for n in FEATURE_NAMES])
+    np.testing.assert_array_equal(load_weight_file(out), load_weight_file(LEARNED))  # the shipped file, reproduced
+
+
+def test_the_shipped_learned_weights_say_where_they_came_from():
+    provenance = load_weights(LEARNED, FEATURE_NAMES).provenance
+    assert provenance["method"] == "maxent-irl" and provenance["demos"] == "shipped"
+    assert len(provenance["train_episodes"].split(", ")) == 3 and provenance["validation_turns"] > 0
+
+
+def test_bad_demonstrations_get_one_clear_message(tmp_path, capsys):
+    assert main(["learn-weights", "--demos", str(tmp_path / "missing"), "--out", str(tmp_path / "w.toml")]) == 2
+    assert "no such file or directory" in capsys.readouterr().err
+    bad = tmp_path / "bad"
+    bad.mkdir()
+    (bad / "broken.json").write_text('{"format": "teachbot-irl-demonstrations", "version": 1, "episodes": 3}')
+    assert main(["learn-weights", "--demos", str(bad), "--out", str(tmp_path / "w.toml")]) == 2
+    error = capsys.readouterr().err
+    assert "broken.json" in error and len(error.strip().splitlines()) == 1
+    assert main(["learn-weights", "--demos", "shipped", "--out", str(tmp_path / "w.txt")]) == 2
+    assert "must end in .toml" in capsys.readouterr().err
+
+
+def test_the_gated_fit_asks_when_the_expert_asks_where_the_plain_softmax_stays_quiet():
+    """The DT decides ask-or-not against its best query; a softmax over a dozen look-alike label queries can
+    only explain an expert who asks half the time by making every single query worse than silence."""
+    from learning.irl_learn import learn_weights
+
+    gated = learn_weights("shipped", policy="gated").weights.provenance
+    softmax = learn_weights("shipped", policy="softmax").weights.provenance
+    assert gated["validation_ask_or_quiet_agreement"] >= 0.8
+    assert gated["validation_ask_or_quiet_agreement"] > softmax["validation_ask_or_quiet_agreement"] + 0.2
