@@ -15,7 +15,7 @@ $(STAMP): pyproject.toml
 	touch $(STAMP)
 
 demo: $(STAMP)
-	$(VENV)/bin/teachbot demo --seed 0 --turns 30 --budget 40 --change-every 5 --strategy active
+	$(VENV)/bin/teachbot demo --seed 0 --turns 30 --budget 40 --change-every 5 --strategy dt-task
 
 test: $(STAMP)
 	$(VENV)/bin/ruff check .

@@ -31,10 +31,19 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     try:
-        return int(args.handler(args) or 0)
+        with one_blas_thread():
+            return int(args.handler(args) or 0)
     except (ValueError, RuntimeError, FileNotFoundError) as error:
         print(f"teachbot {args.command}: {error}", file=sys.stderr)
         return 2
+
+
+def one_blas_thread():
+    """One BLAS thread: the same seed then gives the same transcript on any number of cores (a multi-threaded
+    reduction sums in another order, and a tie between two questions can fall the other way)."""
+    from threadpoolctl import threadpool_limits
+
+    return threadpool_limits(limits=1)
 
 
 if __name__ == "__main__":

@@ -45,6 +45,6 @@ def run(args: argparse.Namespace) -> int:
           f"queries {result.queries}; {result.seconds:.1f} s. Transcript: {result.transcript}")
     if args.json:
         summary = {key: asdict(result)[key] for key in SUMMARY_KEYS}
-        summary["queries"] = {kind: summary["queries"][kind] for kind in ("label", "demo", "none")}
+        summary["queries"] = {kind: summary["queries"][kind] for kind in ("label", "demo", "feature", "none")}
         print(json.dumps(summary))
     return 0

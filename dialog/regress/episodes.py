@@ -64,6 +64,13 @@ def make_teacher(options: dict, rng: np.random.Generator):
 
 def run_episode(spec: EpisodeSpec) -> dict:
     """Run one episode; returns its spec, per-turn series, final accuracy and wall time."""
+    from dialog.cli import one_blas_thread
+
+    with one_blas_thread():
+        return _run_episode(spec)
+
+
+def _run_episode(spec: EpisodeSpec) -> dict:
     started = time.perf_counter()
     pools = load_pools(spec.task, spec.kitchen, spec.dataset + 1, spec.plan)
     condition = spec.condition

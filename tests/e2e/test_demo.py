@@ -22,7 +22,7 @@ def test_demo_runs_and_prints_a_json_summary(tmp_path, capsys):
     assert set(summary) == {"seed", "strategy", "turns", "budget_spent", "queries", "accuracy", "transcript",
                             "seconds"}
     assert summary["turns"] == 8 and summary["budget_spent"] <= 10
-    assert set(summary["queries"]) == {"label", "demo", "none"} and sum(summary["queries"].values()) == 8
+    assert set(summary["queries"]) == {"label", "demo", "feature", "none"} and sum(summary["queries"].values()) == 8
     records = read_transcript(tmp_path / "run.jsonl")  # one record per turn after the session header
     assert len(records) == 8 and len((tmp_path / "run.jsonl").read_text().splitlines()) == 9
     gestures = [record["gesture"] for record in records if "gesture" in record]
