@@ -25,6 +25,24 @@ def budget(text: str) -> float:
     return value
 
 
+def seconds(text: str) -> float:
+    """Zero or more seconds."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number of seconds, got '{text}'") from None
+    if not value >= 0 or value == float("inf"):
+        raise argparse.ArgumentTypeError(f"expected zero or more seconds, got {value:g}")
+    return value
+
+
+def positive_seconds(text: str) -> float:
+    value = seconds(text)
+    if value <= 0:
+        raise argparse.ArgumentTypeError(f"expected a positive number of seconds, got {value:g}")
+    return value
+
+
 def add_episode_options(parser: argparse.ArgumentParser, strategies, default_strategy: str) -> None:
     """--seed --turns --budget --change-every --strategy --task --kitchen --transcript."""
     parser.add_argument("--seed", type=int, default=0, help="one seed for every random choice (default 0)")

@@ -7,7 +7,7 @@ import json
 import sys
 from pathlib import Path
 
-from dialog.commands._arguments import add_episode_options, budget
+from dialog.commands._arguments import add_episode_options, budget, positive_seconds
 from dialog.commands._viewer import add_viewer_option, start_viewer, stop_viewer
 from dialog.environment import SimulatedKitchen
 from dialog.session import SessionSettings, open_session
@@ -28,20 +28,13 @@ def rate(text: str) -> float:
     return value
 
 
-def seconds(text: str) -> float:
-    value = budget(text)
-    if value <= 0:
-        raise argparse.ArgumentTypeError(f"expected a positive number of seconds, got {value}")
-    return value
-
-
 def register(commands) -> None:
     parser = commands.add_parser(
         "teach", help="teach the robot at the terminal: it points, asks, and learns from your answers",
         description="Answer the robot's questions at the terminal. Type 'help' at any question for the accepted "
                     "answers; 'quit' (or end of input) saves the session, which --resume continues.")
     add_episode_options(parser, STRATEGY_NAMES, DEFAULT_STRATEGY)
-    parser.add_argument("--realtime", type=seconds, default=None, metavar="SECONDS",
+    parser.add_argument("--realtime", type=positive_seconds, default=None, metavar="SECONDS",
                         help="real-time mode: each turn lasts SECONDS; a later answer counts as none")
     parser.add_argument("--transcript", type=Path, default=None,
                         help="transcript path (default runs/teach-<task>-<strategy>-seed<seed>.jsonl, numbered "

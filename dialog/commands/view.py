@@ -14,17 +14,7 @@ import sys
 import time
 from pathlib import Path
 
-from dialog.commands._arguments import positive_int
-
-
-def seconds(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a number of seconds, got '{text}'") from None
-    if value < 0:
-        raise argparse.ArgumentTypeError(f"expected zero or more seconds, got {value:g}")
-    return value
+from dialog.commands._arguments import positive_int, seconds
 
 
 def register(commands) -> None:
