@@ -35,7 +35,7 @@ def _parse(argv):
     parser.add_argument("--objects", type=int, nargs="+", default=[12, 55], help="scene sizes |X| (default 12 55)")
     parser.add_argument("--train", type=int, nargs="+", default=[20, 150, 500],
                         help="training-set sizes (default 20 150 500)")
-    parser.add_argument("--weights", default="dt-task-env", help="DT weights: preset name or TOML path")
+    parser.add_argument("--weights", default="dt", help="DT weights: preset name or TOML path")
     parser.add_argument("--repeats", type=int, default=5, help="cold runs per fast timing, best kept (default 5)")
     parser.add_argument("--threads", type=int, default=1, help="BLAS threads (default 1)")
     parser.add_argument("--seed", type=int, default=0)
