@@ -375,7 +375,7 @@ def test_module_imports_no_simulator_viewer_or_application_code():
 @settings(max_examples=40, deadline=None)
 @given(st.integers(0, 10_000), st.sampled_from([0.05, 0.5]))
 def test_forward_search_on_rows_on_demand_equals_the_full_matrix_search(seed, significance):
-    from learning.feature_selection import _forward, _LazyCorrelations, _prepare, _representatives
+    from learning.feature_selection import LazyCorrelations, _forward, _representatives, prepare
 
     rng = np.random.default_rng(seed)
     n_samples, n_features = int(rng.integers(5, 120)), int(rng.integers(2, 30))
@@ -386,10 +386,10 @@ def test_forward_search_on_rows_on_demand_equals_the_full_matrix_search(seed, si
         X[:, -1], X[:, -2] = X[:, 0], 5.0 - 2.0 * X[:, 1]  # exact and decreasing copies
     if seed % 3 == 0:
         X = np.round(X)  # ties and few distinct values
-    table, codes = _prepare(X, y, None)
+    table, codes = prepare(X, y, None)
     class_su = table.class_su(codes, significance)
-    lazy = _forward(class_su, _LazyCorrelations(table), None)
+    lazy = _forward(class_su, LazyCorrelations(table), None)
     assert np.array_equal(lazy, _forward(class_su, table.feature_su, None))
     relevant = np.flatnonzero(class_su > 0)
-    assert np.array_equal(_LazyCorrelations(table).representatives(relevant),
+    assert np.array_equal(LazyCorrelations(table).representatives(relevant),
                           _representatives(table.feature_su[np.ix_(relevant, relevant)]))
