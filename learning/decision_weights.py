@@ -21,11 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from learning.decision_features import FEATURE_NAMES
-
-try:
-    import tomllib
-except ModuleNotFoundError:  # Python 3.10
-    import tomli as tomllib
+from learning.irl_weights import load_weights
 
 WEIGHTS_DIRECTORY = Path(__file__).resolve().parent / "weights"
 PRESETS = ("dt", "dt-iros", "dt-task", "dt-task-env")
@@ -50,22 +46,13 @@ def weight_vector(weights: Mapping[str, float] | Sequence[float] | np.ndarray, s
 
 
 def load_weight_file(path: str | Path) -> np.ndarray:
-    """w from a weights TOML file; a bad file gets a one-line message naming the file and what is accepted."""
-    path = Path(path)
-    if not path.is_file():
-        raise ValueError(f"weights file {path} does not exist")
+    """w from a weights TOML file (read by ``learning.irl_weights``, the one reader of the format); a bad file
+    gets a one-line message naming the file and what is accepted."""
     try:
-        with path.open("rb") as handle:
-            data = tomllib.load(handle)
-    except tomllib.TOMLDecodeError as error:
-        raise ValueError(f"{path}: not valid TOML ({error})") from None
-    unknown = sorted(set(data) - {"weights", "provenance"})
-    if unknown:
-        raise ValueError(f"{path}: unknown table or key {unknown[0]!r}; accepted: [weights], [provenance]")
-    table = data.get("weights")
-    if not isinstance(table, Mapping) or not table:
-        raise ValueError(f"{path}: needs a non-empty [weights] table of decision feature = number")
-    return weight_vector(table, str(path))
+        weights = load_weights(path)
+    except FileNotFoundError as error:
+        raise ValueError(str(error)) from None
+    return weight_vector(weights.as_dict(), str(path))
 
 
 def preset_weights(name: str) -> np.ndarray:

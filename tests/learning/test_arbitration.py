@@ -137,7 +137,7 @@ def test_weight_presets_load_and_bad_weights_are_explained(tmp_path):
         resolve_weights({"prediction_margin": float("nan")})
     bad = tmp_path / "bad.toml"
     bad.write_text("[weights]\nprediction_margin = 'high'\n")
-    with pytest.raises(ValueError, match="bad.toml: weight of prediction_margin must be a finite number"):
+    with pytest.raises(ValueError, match="bad.toml: weight 'prediction_margin' must be a finite number"):
         load_weight_file(bad)
     bad.write_text("weights = 3\n")
     with pytest.raises(ValueError, match=r"needs a non-empty \[weights\] table"):
