@@ -14,6 +14,7 @@ import pkgutil
 import sys
 
 import dialog.commands
+from dialog.threads import one_blas_thread
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -36,14 +37,6 @@ def main(argv: list[str] | None = None) -> int:
     except (ValueError, RuntimeError, FileNotFoundError) as error:
         print(f"teachbot {args.command}: {error}", file=sys.stderr)
         return 2
-
-
-def one_blas_thread():
-    """One BLAS thread: the same seed then gives the same transcript on any number of cores (a multi-threaded
-    reduction sums in another order, and a tie between two questions can fall the other way)."""
-    from threadpoolctl import threadpool_limits
-
-    return threadpool_limits(limits=1)
 
 
 if __name__ == "__main__":

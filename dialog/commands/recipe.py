@@ -20,7 +20,6 @@ import json
 import time
 
 import numpy as np
-from threadpoolctl import threadpool_limits
 
 from dialog.commands._arguments import positive_int
 from dialog.commands._recipe_session import (
@@ -86,9 +85,8 @@ def run(args: argparse.Namespace) -> int:
     started = time.perf_counter()
     recipe = load_any_recipe(args.recipe)
     rng = np.random.default_rng(args.seed)
-    with threadpool_limits(limits=1, user_api="blas"), \
-            NarratedRecipeWorld(recipe_steps(recipe), task=args.task or recipe.name, kitchen=args.kitchen,
-                                seed=args.seed) as world:
+    with NarratedRecipeWorld(recipe_steps(recipe), task=args.task or recipe.name, kitchen=args.kitchen,
+                             seed=args.seed) as world:
         viewer = start_viewer(args, world.world)
         try:
             if viewer is not None:

@@ -15,6 +15,7 @@ import numpy as np
 from dialog.manager import DialogManager, EpisodeConfig, episode_generators
 from dialog.regress.pools import PoolEnvironment, load_pools
 from dialog.regress.suite import Condition
+from dialog.threads import one_blas_thread
 from dialog.transcript import TranscriptWriter, read_transcript
 from learning.strategies import make_strategy
 
@@ -64,8 +65,6 @@ def make_teacher(options: dict, rng: np.random.Generator):
 
 def run_episode(spec: EpisodeSpec) -> dict:
     """Run one episode; returns its spec, per-turn series, final accuracy and wall time."""
-    from dialog.cli import one_blas_thread
-
     with one_blas_thread():
         return _run_episode(spec)
 

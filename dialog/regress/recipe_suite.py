@@ -22,7 +22,6 @@ from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass, replace
 
 import numpy as np
-from threadpoolctl import threadpool_limits
 
 from bullet_world.catalogue import load_kitchen
 from bullet_world.recipe_world import RecipeWorld
@@ -31,6 +30,7 @@ from dialog.regress import recipe_study as science
 from dialog.regress.analysis import CheckpointSummary, FindingResult
 from dialog.regress.runner import _progress
 from dialog.regress.suite import Suite, SuiteError
+from dialog.threads import one_blas_thread
 from learning.recipe import load_builtin_recipe
 from learning.significance import mann_whitney, mean_and_standard_error
 from robot.grasping import GRASP_MODES
@@ -175,7 +175,7 @@ def run_job(job: dict) -> dict:
     """One unit of work in a worker process: collect demonstrations (and execute), or evaluate groundings."""
     recipe = load_builtin_recipe(job["recipe"])
     seed, kind = job["seed"], job["kind"]
-    with threadpool_limits(limits=1, user_api="blas"):  # tiny matrices: more BLAS threads only spin
+    with one_blas_thread():
         if kind == "collect":
             with RecipeWorld(recipe_steps(recipe), task=recipe.name, kitchen=job["kitchen"], seed=seed) as world:
                 demos = world.demonstrate(job["count"], science.demonstration_rng(seed))
