@@ -14,13 +14,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-try:
-    import tomllib
-except ModuleNotFoundError:  # Python 3.10
-    import tomli as tomllib
-
 from bullet_world.camera import Lighting
 from bullet_world.catalogue import DATA_DIR, DataFileError, load_task
+from bullet_world.datafiles import read_toml
 
 ELSEWHERE = "elsewhere"  # free counter space outside every location the recipe uses
 SETUP_FIELDS = ("recipe", "reach", "region_margin", "min_gap", "layouts", "jitter_m", "yaw_jitter",
@@ -79,8 +75,7 @@ def load_recipe_setup(name_or_path: str | Path) -> RecipeSceneSetup:
     if path.suffix != ".toml":
         path = DATA_DIR / "tasks" / f"{name_or_path}.toml"
     task = load_task(path if path.exists() else name_or_path)  # an unknown name gets the catalogue's message
-    with open(path, "rb") as handle:
-        table = tomllib.load(handle)
+    table = read_toml(path)
     where = f"{path} [recipe_scenes]"
     if "recipe_scenes" not in table:
         raise DataFileError(f"{path}: task '{task.name}' has no [recipe_scenes] table; it is not a recipe task")

@@ -7,15 +7,13 @@ hidden ground truth.
 
 from __future__ import annotations
 
-try:
-    import tomllib
-except ModuleNotFoundError:  # Python 3.10
-    import tomli as tomllib
 import colorsys
 from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
+
+from learning.toml_files import read_toml
 
 COLOURS_FILE = Path(__file__).parent / "data" / "colours.toml"
 SIZE_FEATURES = {"length": ("size.length", "bbox.length", "length"), "width": ("size.width", "bbox.width", "width"),
@@ -30,8 +28,7 @@ SURFACES = ("counter", "table", "worktop")
 
 @lru_cache(maxsize=2)
 def colour_table(path: str | Path = COLOURS_FILE) -> dict:
-    with open(path, "rb") as handle:
-        table = tomllib.load(handle)
+    table = read_toml(path, "colour table")
     for key in ("grey_saturation", "grey", "hue"):
         if key not in table:
             raise ValueError(f"{path}: missing '{key}'")

@@ -41,11 +41,7 @@ import numpy as np
 from dialog.expert import ExpertView
 from learning.actions import Action, DemoQuery, FeatureQuery, NoQuery
 from learning.decision_features import label_distribution
-
-try:
-    import tomllib
-except ModuleNotFoundError:  # Python 3.10
-    import tomli as tomllib
+from learning.toml_files import read_toml
 
 RULES_FILE = Path(__file__).parent / "data" / "scripted-expert.toml"
 
@@ -61,8 +57,7 @@ class ExpertRules:
     @classmethod
     def load(cls, path: str | Path = RULES_FILE) -> ExpertRules:
         path = Path(path)
-        with path.open("rb") as handle:
-            data = tomllib.load(handle)
+        data = read_toml(path, "scripted-expert rules")
         try:
             examples = data["examples"]
             rules = cls(int(data["feature_query"]["by_turn"]), float(data["pace"]["head_start_turns"]),

@@ -29,11 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from learning.irl_data import check_feature_names
-
-try:
-    import tomllib
-except ModuleNotFoundError:  # Python 3.10: the tomli backport has the same API
-    import tomli as tomllib
+from learning.toml_files import read_toml
 
 WEIGHTS_TABLE = "weights"
 PROVENANCE_TABLE = "provenance"
@@ -127,15 +123,7 @@ def save_weights(path: str | Path, weights: DecisionWeights, comment: str = "") 
 
 def load_weights(path: str | Path, feature_names: Sequence[str] | None = None) -> DecisionWeights:
     """Read a weights TOML file; with ``feature_names`` the weights come back in that order, all present."""
-    path = Path(path)
-    if not path.is_file():
-        raise FileNotFoundError(f"weights file {path} does not exist")
-    try:
-        with path.open("rb") as handle:
-            data = tomllib.load(handle)
-    except tomllib.TOMLDecodeError as error:
-        raise ValueError(f"{path}: not valid TOML ({error})") from None
-    return weights_from_mapping(data, feature_names, source=str(path))
+    return weights_from_mapping(read_toml(path, "weights"), feature_names, source=str(path))
 
 
 def weights_from_mapping(data: Mapping, feature_names: Sequence[str] | None = None,

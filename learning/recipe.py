@@ -31,10 +31,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-try:
-    import tomllib
-except ModuleNotFoundError:  # Python 3.10: the tomli backport has the same API
-    import tomli as tomllib
+from learning.toml_files import read_toml
 
 PICK_PLACE = "pick-place"
 ACCEPTED_ACTIONS: tuple[str, ...] = (PICK_PLACE,)
@@ -92,15 +89,7 @@ def recipe_parameters(recipe: Recipe) -> RecipeParameters:
 
 def load_recipe(path: str | Path) -> Recipe:
     """Read and validate a recipe TOML file; bad content raises a one-line ValueError."""
-    path = Path(path)
-    if not path.is_file():
-        raise FileNotFoundError(f"recipe file {path} does not exist")
-    try:
-        with path.open("rb") as handle:
-            data = tomllib.load(handle)
-    except tomllib.TOMLDecodeError as error:
-        raise ValueError(f"{path}: not valid TOML ({error})") from None
-    return recipe_from_mapping(data, source=str(path))
+    return recipe_from_mapping(read_toml(path, "recipe"), source=str(path))
 
 
 def recipe_from_mapping(data: dict[str, Any], source: str = "recipe") -> Recipe:
