@@ -13,18 +13,9 @@ from pathlib import Path
 
 import numpy as np
 
-from bullet_world.datafiles import (
-    DATA_DIR,
-    DataFileError,
-    colour_list,
-    number_range,
-    optional,
-    read_toml,
-    resolve,
-    string_list,
-)
-from bullet_world.datafiles import field as table_field
+from bullet_world.datafiles import DATA_DIR, DataFileError, colour_list, read_toml, resolve
 from bullet_world.kitchen import INTEREST_POINTS, Kitchen, Location, load_kitchen
+from learning.datafiles import check_keys, flag, integer, number, numbers, section, tables, text, texts, value_range
 
 __all__ = ["DATA_DIR", "SHAPES", "DataFileError", "Kitchen", "KindState", "Location", "ObjectKind", "Task",
            "load_kitchen", "load_object_kinds", "load_task"]
@@ -38,6 +29,12 @@ SHAPES = {
     "bag": ("length", "width", "height"),  # a sealed, puffed pouch
     "slices": ("radius", "height"),      # 'count' half-disc slices laid flat in a row
 }
+STATE_FIELDS = ("shape", "length", "width", "height", "radius", "colours", "colour_jitter", "mass", "texture",
+                "inner_colour", "location", "profile", "open", "fill", "count")
+KIND_FIELDS = ("name", "concept", "kitchens", "state")
+TASK_FIELDS = ("name", "description", "concepts", "objects", "objects_per_scene", "max_objects_per_scene",
+               "test_scenes", "placement", "state_change_probability", "relevant_features", "datasets",
+               "recipe_scenes")
 TEXTURES = ("plain", "speckle", "print", "crinkle", "stripes", "label", "window", "metal", "ceramic", "flesh",
             "wrapper")
 
@@ -96,69 +93,66 @@ class ObjectKind:
                 "mass": float(rng.uniform(*look.mass)), "state": min(max(int(state), 0), len(self.states) - 1)}
 
 
+def _profile(table: dict, where: str) -> tuple[tuple[float, float], ...]:
+    points = table.get("profile")
+    if not isinstance(points, list) or len(points) < 2:
+        raise DataFileError(f"{where}: 'profile' needs at least two [radius, height] points, got {points!r}")
+    profile = tuple(numbers({"profile": p}, "profile", f"{where} profile point {i + 1}", length=2, low=0.0, high=1.0)
+                    for i, p in enumerate(points))
+    heights = [p[1] for p in profile]
+    if heights != sorted(heights) or heights[0] != 0.0 or heights[-1] != 1.0:
+        raise DataFileError(f"{where}: 'profile' points must rise from height 0 to 1 with radii in 0..1")
+    return profile
+
+
 def _state(table: dict, name: str, where: str, defaults: dict) -> KindState:
     """One state from ``table``; fields it leaves out come from ``defaults`` (the kind's own fields)."""
     merged = {**defaults, **table}
-    shape = table_field(merged, "shape", where, str)
-    if shape not in SHAPES:
-        raise DataFileError(f"{where}: shape '{shape}' is not one of {', '.join(SHAPES)}")
-    texture = optional(merged, "texture", where, "plain", str)
-    if texture not in TEXTURES:
-        raise DataFileError(f"{where}: texture '{texture}' is not one of {', '.join(TEXTURES)}")
-    profile: tuple = ()
-    if shape == "lathe":
-        points = table_field(merged, "profile", where, list)
-        if len(points) < 2:
-            raise DataFileError(f"{where}: 'profile' needs at least two [radius, height] points")
-        profile = tuple(tuple(table_field({"profile": p}, "profile", where, length=2)) for p in points)
-        heights = [p[1] for p in profile]
-        if heights != sorted(heights) or heights[0] != 0.0 or heights[-1] != 1.0 or \
-                not all(0.0 <= p[0] <= 1.0 for p in profile):
-            raise DataFileError(f"{where}: 'profile' points must rise from height 0 to 1 with radii in 0..1")
-    fill = float(optional(merged, "fill", where, 0.0))
-    if not 0.0 <= fill < 1.0:
-        raise DataFileError(f"{where}: 'fill' must be in [0, 1), got {fill}")
-    count = int(optional(merged, "count", where, 3, int))
-    if not 1 <= count <= 8:
-        raise DataFileError(f"{where}: 'count' must be 1..8 slices, got {count}")
-    location = optional(merged, "location", where, None, str)
-    if location is not None and location not in INTEREST_POINTS:
-        raise DataFileError(f"{where}: location '{location}' is not one of {', '.join(INTEREST_POINTS)}")
+    shape = text(merged, "shape", where, choices=SHAPES)
     return KindState(
-        name=name, shape=shape, dimensions={key: number_range(merged, key, where) for key in SHAPES[shape]},
-        colours=colour_list(merged, "colours", where), colour_jitter=float(table_field(merged, "colour_jitter", where)),
-        mass=number_range(merged, "mass", where), texture=texture,
-        inner_colour=tuple(optional(merged, "inner_colour", where, [0.9, 0.85, 0.7], length=3)),
-        location=location, profile=profile, open_top=bool(optional(merged, "open", where, False, bool)),
-        fill=fill, count=count,
+        name=name, shape=shape,
+        dimensions={key: _size(merged, key, where) for key in SHAPES[shape]},
+        colours=colour_list(merged, "colours", where), colour_jitter=number(merged, "colour_jitter", where, low=0.0),
+        mass=value_range(merged, "mass", where, low=0.0), texture=text(merged, "texture", where, "plain",
+                                                                        choices=TEXTURES),
+        inner_colour=numbers(merged, "inner_colour", where, (0.9, 0.85, 0.7), length=3, low=0.0, high=1.0),
+        location=text(merged, "location", where, None, choices=INTEREST_POINTS),
+        profile=_profile(merged, where) if shape == "lathe" else (), open_top=flag(merged, "open", where, False),
+        fill=number(merged, "fill", where, 0.0, low=0.0, below=1.0), count=integer(merged, "count", where, 3, 1, 8),
     )
+
+
+def _size(table: dict, key: str, where: str) -> tuple[float, float]:
+    """A size range in metres: [low, high] with 0 < low <= high."""
+    numbers(table, key, where, length=2, above=0.0)
+    return value_range(table, key, where)
 
 
 def load_object_kinds(name_or_path: str | Path) -> list[ObjectKind]:
     """Load a catalogue of object kinds from ``data/objects/NAME.toml`` (or a path)."""
     path = resolve("objects", name_or_path)
-    kinds = read_toml(path).get("kind")
-    if not isinstance(kinds, list) or not kinds:
-        raise DataFileError(f"{path}: needs at least one [[kind]] table")
+    table = read_toml(path, "objects")
+    check_keys(table, str(path), required=("kind",))
+    kinds = tables(table, "kind", str(path), nonempty=True)
     result = []
     for index, table in enumerate(kinds):
         where = f"{path}: kind {index + 1}"
-        name = table_field(table, "name", where, str)
-        defaults = {key: value for key, value in table.items() if key not in ("state", "name", "concept", "kitchens")}
-        state_tables = table.get("state", [])
-        if not isinstance(state_tables, list):
-            raise DataFileError(f"{where}: states must be [[kind.state]] tables")
-        if state_tables:
-            states = tuple(_state(entry, table_field(entry, "name", f"{where} state {i + 1}", str),
-                                  f"{where} ({name}) state {i + 1}", defaults)
-                           for i, entry in enumerate(state_tables))
-        else:
-            states = (_state({}, "as-is", f"{where} ({name})", defaults),)
+        check_keys(table, where, required=("name", "concept"), optional=KIND_FIELDS[2:] + STATE_FIELDS)
+        name = text(table, "name", where)
+        defaults = {key: value for key, value in table.items() if key not in KIND_FIELDS}
+        state_tables = tables(table, "state", where, [])
+        states = []
+        for i, entry in enumerate(state_tables):
+            here = f"{where} ({name}) state {i + 1}"
+            check_keys(entry, here, required=("name",), optional=STATE_FIELDS)
+            states.append(_state(entry, text(entry, "name", here), here, defaults))
+        if not states:
+            states = [_state({}, "as-is", f"{where} ({name})", defaults)]
         first = states[0]
         result.append(ObjectKind(
-            name=name, concept=table_field(table, "concept", where, str), shape=first.shape,
+            name=name, concept=text(table, "concept", where), shape=first.shape,
             dimensions=first.dimensions, colours=first.colours, colour_jitter=first.colour_jitter, mass=first.mass,
-            states=states, kitchens=string_list(table, "kitchens", where),
+            states=tuple(states), kitchens=texts(table, "kitchens", where, ()),
         ))
     names = [kind.name for kind in result]
     if len(set(names)) != len(names):
@@ -215,24 +209,25 @@ class Task:
 
 
 def _dataset_plan(table: dict, where: str, default_objects: int) -> DatasetPlan:
-    plan = DatasetPlan(
-        pools=int(optional(table, "pools", where, 5, int)),
-        pool_size=int(optional(table, "pool_size", where, 400, int)),
-        test_size=int(optional(table, "test_size", where, 200, int)),
-        objects_per_scene=int(optional(table, "objects_per_scene", where, default_objects, int)),
+    check_keys(table, where, optional=("pools", "pool_size", "test_size", "objects_per_scene"))
+    return DatasetPlan(
+        pools=integer(table, "pools", where, 5, low=1), pool_size=integer(table, "pool_size", where, 400, low=1),
+        test_size=integer(table, "test_size", where, 200, low=1),
+        objects_per_scene=integer(table, "objects_per_scene", where, default_objects, low=1),
     )
-    if min(plan.pools, plan.pool_size, plan.test_size, plan.objects_per_scene) < 1:
-        raise DataFileError(f"{where}: pools, pool_size, test_size and objects_per_scene must be at least 1")
-    return plan
 
 
 def load_task(name_or_path: str | Path) -> Task:
     """Load ``data/tasks/NAME.toml`` and its object catalogue."""
     path = resolve("tasks", name_or_path)
-    table = read_toml(path)
+    table = read_toml(path, "task")
     where = str(path)
-    concepts = tuple(table_field(table, "concepts", where, list))
-    objects_path = resolve("objects", table_field(table, "objects", where, str))
+    check_keys(table, where, required=("name", "concepts", "objects", "objects_per_scene", "test_scenes"),
+               optional=TASK_FIELDS)
+    concepts = texts(table, "concepts", where, nonempty=True)
+    if len(set(concepts)) != len(concepts):
+        raise DataFileError(f"{where}: 'concepts' must not repeat a name, got {list(concepts)}")
+    objects_path = resolve("objects", text(table, "objects", where))
     kinds = tuple(load_object_kinds(objects_path))
     missing = sorted({k.concept for k in kinds} - set(concepts))
     if missing:
@@ -240,30 +235,22 @@ def load_task(name_or_path: str | Path) -> Task:
     uncovered = sorted(set(concepts) - {k.concept for k in kinds})
     if uncovered:
         raise DataFileError(f"{where}: no object kind for concepts {uncovered}")
-    count = table_field(table, "objects_per_scene", where, int)
-    if count < len(concepts):
-        raise DataFileError(f"{where}: 'objects_per_scene' must be at least the number of concepts ({len(concepts)})")
-    largest = int(optional(table, "max_objects_per_scene", where, count, int))
-    if largest < count:
-        raise DataFileError(f"{where}: 'max_objects_per_scene' ({largest}) is below 'objects_per_scene' ({count})")
-    placement = optional(table, "placement", where, "anywhere", str)
-    if placement not in ("anywhere", "locations"):
-        raise DataFileError(f"{where}: 'placement' must be 'anywhere' or 'locations', got '{placement}'")
-    probability = float(optional(table, "state_change_probability", where, 0.0))
-    if not 0.0 <= probability <= 1.0:
-        raise DataFileError(f"{where}: 'state_change_probability' must be in 0..1, got {probability}")
+    count = integer(table, "objects_per_scene", where, low=len(concepts))
+    largest = integer(table, "max_objects_per_scene", where, count, low=count)
+    placement = text(table, "placement", where, "anywhere", choices=("anywhere", "locations"))
+    probability = number(table, "state_change_probability", where, 0.0, low=0.0, high=1.0)
     task = Task(
-        name=table_field(table, "name", where, str),
-        description=table.get("description", ""),
+        name=text(table, "name", where),
+        description=text(table, "description", where, "", nonempty=False),
         concepts=concepts,
         kinds=kinds,
         objects_per_scene=count,
-        test_scenes=table_field(table, "test_scenes", where, int),
+        test_scenes=integer(table, "test_scenes", where, low=1),
         max_objects_per_scene=largest,
         place_at_locations=placement == "locations",
         state_change_probability=probability,
-        relevant_patterns=string_list(table, "relevant_features", where),
-        datasets=_dataset_plan(table.get("datasets", {}), f"{where} [datasets]", count),
+        relevant_patterns=texts(table, "relevant_features", where, ()),
+        datasets=_dataset_plan(section(table, "datasets", where, {}), f"{where} [datasets]", count),
         path=where,
         objects_path=str(objects_path),
     )

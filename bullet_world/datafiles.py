@@ -1,89 +1,44 @@
 """Reading and validating the TOML data files under ``bullet_world/data/``, and the on-disk cache.
 
-Every check raises :class:`DataFileError` with a one-line message naming the
-file, the field, and what is accepted.
+Reading and the field checks are the shared layer :mod:`learning.datafiles`; every
+problem is a :class:`learning.errors.DataFileError` naming the file, the field and
+what is accepted.
 """
 
 from __future__ import annotations
 
-try:
-    import tomllib
-except ModuleNotFoundError:  # Python 3.10
-    import tomli as tomllib
 import os
 from pathlib import Path
+
+from learning.datafiles import numbers
+from learning.datafiles import read_toml as read_data_file
+from learning.errors import DataFileError
+
+__all__ = ["CACHE_ENV", "DATA_DIR", "DataFileError", "available", "cache_dir", "colour_list", "read_toml", "resolve",
+           "write_atomically"]
 
 DATA_DIR = Path(__file__).parent / "data"
 CACHE_ENV = "TEACHBOT_CACHE"
 
 
-class DataFileError(ValueError):
-    """A kitchen, task or object file is missing, malformed or inconsistent."""
-
-
-def read_toml(path: Path) -> dict:
-    try:
-        with open(path, "rb") as handle:
-            return tomllib.load(handle)
-    except FileNotFoundError:
-        raise DataFileError(f"{path}: no such file") from None
-    except tomllib.TOMLDecodeError as error:
-        raise DataFileError(f"{path}: not valid TOML ({error})") from None
-
-
-def _is_number(value) -> bool:
-    return isinstance(value, (int, float)) and not isinstance(value, bool)
-
-
-def field(table: dict, key: str, where: str, kind: type | tuple = (int, float), length: int | None = None):
-    """Return ``table[key]`` after checking its type (and, for number lists, its length)."""
-    if key not in table:
-        raise DataFileError(f"{where}: missing field '{key}'")
-    value = table[key]
-    if length is not None:
-        if not isinstance(value, list) or len(value) != length or not all(_is_number(v) for v in value):
-            raise DataFileError(f"{where}: '{key}' must be a list of {length} numbers, got {value!r}")
-        return [float(v) for v in value]
-    if kind == (int, float) and not _is_number(value):
-        raise DataFileError(f"{where}: '{key}' must be a number, got {value!r}")
-    if not isinstance(value, kind) or (isinstance(value, bool) and kind is not bool):
-        raise DataFileError(f"{where}: '{key}' has the wrong type ({type(value).__name__}), got {value!r}")
-    return value
-
-
-def optional(table: dict, key: str, where: str, default, kind: type | tuple = (int, float), length: int | None = None):
-    """Like :func:`field` but returns ``default`` when the key is absent."""
-    return field(table, key, where, kind, length) if key in table else default
-
-
-def number_range(table: dict, key: str, where: str) -> tuple[float, float]:
-    low, high = field(table, key, where, length=2)
-    if not 0 <= low <= high:
-        raise DataFileError(f"{where}: '{key}' must be [low, high] with 0 <= low <= high, got {[low, high]}")
-    return low, high
+def read_toml(path: Path, what: str = "data") -> dict:
+    """A data file parsed by the shared layer (:func:`learning.datafiles.read_toml`)."""
+    return read_data_file(path, what)
 
 
 def colour_list(table: dict, key: str, where: str) -> tuple[tuple[float, float, float], ...]:
     """A non-empty list of [r, g, b] colours with channels in 0..1."""
-    colours = field(table, key, where, list)
-    if not colours:
-        raise DataFileError(f"{where}: '{key}' must list at least one [r, g, b]")
-    result = []
-    for colour in colours:
-        rgb = field({key: colour}, key, where, length=3)
-        if not all(0.0 <= c <= 1.0 for c in rgb):
-            raise DataFileError(f"{where}: colours in '{key}' must have channels in 0..1, got {colour}")
-        result.append(tuple(rgb))
-    return tuple(result)
-
-
-def string_list(table: dict, key: str, where: str, default=()) -> tuple[str, ...]:
+    colours = table.get(key)
     if key not in table:
-        return tuple(default)
-    value = table[key]
-    if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
-        raise DataFileError(f"{where}: '{key}' must be a list of names, got {value!r}")
-    return tuple(value)
+        raise DataFileError(f"{where}: missing field '{key}'")
+    if not isinstance(colours, list) or not colours:
+        raise DataFileError(f"{where}: '{key}' must list at least one [r, g, b] colour, got {colours!r}")
+    result = tuple(numbers({key: colour}, key, f"{where} colour {index + 1}", length=3)
+                   for index, colour in enumerate(colours))
+    for colour in result:
+        if not all(0.0 <= channel <= 1.0 for channel in colour):
+            raise DataFileError(f"{where}: colours in '{key}' must have channels in 0..1, got {list(colour)}")
+    return result
 
 
 def available(folder: str) -> list[str]:

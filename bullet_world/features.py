@@ -9,18 +9,15 @@ microphone and the light sensor; robot features from the attached robot.
 
 from __future__ import annotations
 
-try:
-    import tomllib
-except ModuleNotFoundError:  # Python 3.10
-    import tomli as tomllib
 from dataclasses import dataclass
 from functools import lru_cache
 
 import numpy as np
 
-from bullet_world.datafiles import DATA_DIR, DataFileError
+from bullet_world.datafiles import DATA_DIR, DataFileError, read_toml
 from bullet_world.kitchen import INTEREST_POINTS, Kitchen
 from bullet_world.perception import ObjectMeasurement
+from learning.datafiles import check_keys, tables, text
 
 SOURCES = ("object", "environment", "robot")
 CROWDING_RADIUS_M = 0.20
@@ -39,18 +36,20 @@ class FeatureInfo:
 @lru_cache(maxsize=1)
 def feature_catalogue() -> tuple[FeatureInfo, ...]:
     """Every feature of ``data/features.toml``, in file order."""
-    path = DATA_DIR / "features.toml"
-    with open(path, "rb") as handle:
-        entries = tomllib.load(handle).get("feature", [])
+    return load_feature_catalogue(DATA_DIR / "features.toml")
+
+
+def load_feature_catalogue(path) -> tuple[FeatureInfo, ...]:
+    """Read and check a feature catalogue file (``[[feature]]`` tables of name, group, description, source)."""
+    table = read_toml(path, "features")
+    check_keys(table, str(path), required=("feature",))
     infos = []
-    for index, entry in enumerate(entries):
-        missing = [key for key in ("name", "group", "description") if not entry.get(key)]
-        if missing:
-            raise DataFileError(f"{path}: feature {index + 1} lacks {', '.join(missing)}")
-        source = entry.get("source", "object")
-        if source not in SOURCES:
-            raise DataFileError(f"{path}: feature '{entry['name']}' has source '{source}'; use {', '.join(SOURCES)}")
-        infos.append(FeatureInfo(entry["name"], entry["group"], entry["description"], source))
+    for index, entry in enumerate(tables(table, "feature", str(path), nonempty=True)):
+        where = f"{path}: feature {index + 1}"
+        check_keys(entry, where, required=("name", "group", "description"), optional=("source",))
+        infos.append(FeatureInfo(text(entry, "name", where), text(entry, "group", where),
+                                 text(entry, "description", where), text(entry, "source", where, "object",
+                                                                         choices=SOURCES)))
     names = [info.name for info in infos]
     if len(set(names)) != len(names):
         raise DataFileError(f"{path}: feature names must be unique")

@@ -6,8 +6,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from bullet_world.datafiles import DataFileError, number_range, optional, read_toml, resolve
-from bullet_world.datafiles import field as table_field
+from bullet_world.datafiles import DataFileError, read_toml, resolve
+from learning.datafiles import check_keys, integer, number, numbers, text, value_range
+from learning.datafiles import section as table_section
 
 # The interest points every kitchen places (thesis Table 5.1: "location relative to five interest points").
 INTEREST_POINTS = ("stove", "fridge", "cupboard", "pantry", "counter")
@@ -85,71 +86,87 @@ class Kitchen:
 def _location(name: str, table, where: str) -> Location:
     if not isinstance(table, dict):
         raise DataFileError(f"{where}: must be a table with 'centre' = [x, y, z] and 'half_size' = [hx, hy]")
-    half = table_field(table, "half_size", where, length=2)
-    if min(half) <= 0:
-        raise DataFileError(f"{where}: 'half_size' must be positive, got {half}")
-    return Location(name, tuple(table_field(table, "centre", where, length=3)), tuple(half))
+    check_keys(table, where, required=("centre", "half_size"))
+    half = numbers(table, "half_size", where, length=2, above=0.0)
+    return Location(name, numbers(table, "centre", where, length=3), half)
 
 
 def _camera(section: dict, where: str) -> dict:
-    camera = {key: table_field(section, key, where, length=3) for key in ("eye", "target", "up")}
-    for key in ("fov_degrees", "near", "far"):
-        camera[key] = float(table_field(section, key, where))
+    check_keys(section, where, required=("eye", "target", "up", "fov_degrees", "near", "far", "width", "height"))
+    camera = {key: list(numbers(section, key, where, length=3)) for key in ("eye", "target", "up")}
+    if camera["eye"] == camera["target"] or not any(camera["up"]):
+        raise DataFileError(f"{where}: 'eye' and 'target' must differ and 'up' must not be [0, 0, 0]")
+    camera["fov_degrees"] = number(section, "fov_degrees", where, above=0.0, below=180.0)
+    camera["near"] = number(section, "near", where, above=0.0)
+    camera["far"] = number(section, "far", where, above=camera["near"])
     for key in ("width", "height"):
-        camera[key] = int(table_field(section, key, where, int))
-        if not 32 <= camera[key] <= 4096:
-            raise DataFileError(f"{where}: '{key}' must be between 32 and 4096 pixels, got {camera[key]}")
+        camera[key] = integer(section, key, where, low=32, high=4096)
     return camera
 
 
 def _lighting(section: dict, where: str) -> dict:
+    check_keys(section, where, required=("direction", "direction_jitter", "ambient", "diffuse"),
+               optional=("colour", "colour_jitter"))
+    direction = numbers(section, "direction", where, length=3)
+    if not any(direction):
+        raise DataFileError(f"{where}: 'direction' must not be [0, 0, 0]")
     return {
-        "direction": table_field(section, "direction", where, length=3),
-        "direction_jitter": float(table_field(section, "direction_jitter", where)),
-        "ambient": number_range(section, "ambient", where),
-        "diffuse": number_range(section, "diffuse", where),
-        "colour": tuple(optional(section, "colour", where, [1.0, 1.0, 1.0], length=3)),
-        "colour_jitter": float(optional(section, "colour_jitter", where, 0.0)),
+        "direction": list(direction),
+        "direction_jitter": number(section, "direction_jitter", where, low=0.0),
+        "ambient": value_range(section, "ambient", where, low=0.0, high=1.0),
+        "diffuse": value_range(section, "diffuse", where, low=0.0, high=1.0),
+        "colour": numbers(section, "colour", where, (1.0, 1.0, 1.0), length=3, low=0.0, high=1.0),
+        "colour_jitter": number(section, "colour_jitter", where, 0.0, low=0.0),
     }
 
 
 def _ambient_noise(section: dict, where: str) -> dict:
+    check_keys(section, where, optional=("level_db", "events_per_minute", "event_db"))
     return {
-        "level_db": number_range(section, "level_db", where) if "level_db" in section else (35.0, 45.0),
-        "events_per_minute": float(optional(section, "events_per_minute", where, 1.0)),
-        "event_db": number_range(section, "event_db", where) if "event_db" in section else (55.0, 70.0),
+        "level_db": value_range(section, "level_db", where, (35.0, 45.0), low=0.0),
+        "events_per_minute": number(section, "events_per_minute", where, 1.0, low=0.0),
+        "event_db": value_range(section, "event_db", where, (55.0, 70.0), low=0.0),
+    }
+
+
+def _object_region(region: dict, where: str) -> dict:
+    check_keys(region, where, required=("x", "y", "min_gap"),
+               optional=("min_reach", "max_reach", "max_bearing_degrees", "focus", "focus_spread"))
+    min_reach = number(region, "min_reach", where, 0.0, low=0.0)
+    return {
+        "region_x": value_range(region, "x", where), "region_y": value_range(region, "y", where),
+        "min_gap": number(region, "min_gap", where, low=0.0), "min_reach": min_reach,
+        "max_reach": number(region, "max_reach", where, float("inf"), above=min_reach),
+        "max_bearing": number(region, "max_bearing_degrees", where, 180.0, above=0.0, high=180.0),
+        "focus": numbers(region, "focus", where, None, length=2),
+        "focus_spread": number(region, "focus_spread", where, 0.25, above=0.0),
     }
 
 
 def load_kitchen(name_or_path) -> Kitchen:
     """Load ``data/kitchens/NAME.toml`` (or a path) and check that every location is within reach."""
     path = resolve("kitchens", name_or_path)
-    table = read_toml(path)
+    table = read_toml(path, "kitchen")
     where = str(path)
-    section = {key: table_field(table, key, where, dict) for key in
+    check_keys(table, where, required=("name", "counter", "robot", "object_region", "camera", "lighting", "locations"),
+               optional=("description", "ambient_noise"))
+    section = {key: table_section(table, key, where) for key in
                ("counter", "robot", "object_region", "camera", "lighting", "locations")}
-    region = section["object_region"]
-    region_where = f"{where} [object_region]"
-    focus = optional(region, "focus", region_where, None, length=2)
+    counter, robot = section["counter"], section["robot"]
+    check_keys(counter, f"{where} [counter]", required=("size", "centre", "colour"))
+    check_keys(robot, f"{where} [robot]", required=("base", "yaw_degrees"))
     kitchen = Kitchen(
-        name=table_field(table, "name", where, str),
-        description=table.get("description", ""),
-        counter_size=tuple(table_field(section["counter"], "size", f"{where} [counter]", length=3)),
-        counter_centre=tuple(table_field(section["counter"], "centre", f"{where} [counter]", length=2)),
-        counter_colour=tuple(table_field(section["counter"], "colour", f"{where} [counter]", length=3)),
-        robot_base=tuple(table_field(section["robot"], "base", f"{where} [robot]", length=3)),
-        robot_yaw=float(np.radians(table_field(section["robot"], "yaw_degrees", f"{where} [robot]"))),
-        region_x=tuple(table_field(region, "x", region_where, length=2)),
-        region_y=tuple(table_field(region, "y", region_where, length=2)),
-        min_gap=float(table_field(region, "min_gap", region_where)),
-        min_reach=float(optional(region, "min_reach", region_where, 0.0)),
-        max_reach=float(optional(region, "max_reach", region_where, float("inf"))),
-        max_bearing=float(optional(region, "max_bearing_degrees", region_where, 180.0)),
-        focus=tuple(focus) if focus else None,
-        focus_spread=float(optional(region, "focus_spread", region_where, 0.25)),
+        name=text(table, "name", where),
+        description=text(table, "description", where, "", nonempty=False),
+        counter_size=numbers(counter, "size", f"{where} [counter]", length=3, above=0.0),
+        counter_centre=numbers(counter, "centre", f"{where} [counter]", length=2),
+        counter_colour=numbers(counter, "colour", f"{where} [counter]", length=3, low=0.0, high=1.0),
+        robot_base=numbers(robot, "base", f"{where} [robot]", length=3),
+        robot_yaw=float(np.radians(number(robot, "yaw_degrees", f"{where} [robot]"))),
+        **_object_region(section["object_region"], f"{where} [object_region]"),
         camera=_camera(section["camera"], f"{where} [camera]"),
         lighting=_lighting(section["lighting"], f"{where} [lighting]"),
-        ambient_noise=_ambient_noise(table.get("ambient_noise", {}), f"{where} [ambient_noise]"),
+        ambient_noise=_ambient_noise(table_section(table, "ambient_noise", where, {}), f"{where} [ambient_noise]"),
         locations={name: _location(name, entry, f"{where} [locations.{name}]")
                    for name, entry in section["locations"].items()},
     )

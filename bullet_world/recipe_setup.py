@@ -11,6 +11,7 @@ is accepted. The format is documented in ``docs/recipes.md``.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -164,10 +165,12 @@ def _field(table: dict, key: str, where: str, kind: type | tuple = (int, float),
     value = table[key]
     if length is not None:
         if not isinstance(value, list) or len(value) != length or not all(
-                isinstance(v, (int, float)) and not isinstance(v, bool) for v in value):
-            raise DataFileError(f"{where}: '{key}' must be a list of {length} numbers, got {value!r}")
+                isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in value):
+            raise DataFileError(f"{where}: '{key}' must be a list of {length} finite numbers, got {value!r}")
         return [float(v) for v in value]
     if not isinstance(value, kind) or isinstance(value, bool):
         expected = kind.__name__ if isinstance(kind, type) else "a number"
         raise DataFileError(f"{where}: '{key}' must be {expected}, got {value!r}")
+    if isinstance(value, float) and not math.isfinite(value):
+        raise DataFileError(f"{where}: '{key}' must be a finite number, got {value!r}")
     return value

@@ -13,7 +13,8 @@ from pathlib import Path
 
 import numpy as np
 
-from learning.toml_files import read_toml
+from learning.datafiles import check_keys, number, read_toml, tables, text
+from learning.errors import DataFileError
 
 COLOURS_FILE = Path(__file__).parent / "data" / "colours.toml"
 SIZE_FEATURES = {"length": ("size.length", "bbox.length", "length"), "width": ("size.width", "bbox.width", "width"),
@@ -29,9 +30,27 @@ SURFACES = ("counter", "table", "worktop")
 @lru_cache(maxsize=2)
 def colour_table(path: str | Path = COLOURS_FILE) -> dict:
     table = read_toml(path, "colour table")
-    for key in ("grey_saturation", "grey", "hue"):
-        if key not in table:
-            raise ValueError(f"{path}: missing '{key}'")
+    where = str(path)
+    check_keys(table, where, required=("grey_saturation", "grey", "hue"))
+    number(table, "grey_saturation", where, low=0.0, high=1.0)
+    for index, grey in enumerate(tables(table, "grey", where, nonempty=True)):
+        here = f"{where} grey {index + 1}"
+        check_keys(grey, here, required=("name", "below_value"))
+        text(grey, "name", here)
+        number(grey, "below_value", here, low=0.0)
+    for index, band in enumerate(tables(table, "hue", where, nonempty=True)):
+        here = f"{where} hue {index + 1}"
+        check_keys(band, here, required=("name", "from", "to"),
+                   optional=("pale_name", "pale_saturation", "dark_name", "dark_value"))
+        text(band, "name", here)
+        start = number(band, "from", here, low=0.0, high=360.0)
+        number(band, "to", here, above=start, high=360.0)
+        for name_key, limit_key in (("pale_name", "pale_saturation"), ("dark_name", "dark_value")):
+            if (name_key in band) != (limit_key in band):
+                raise DataFileError(f"{here}: '{name_key}' and '{limit_key}' go together; give both or neither")
+            if name_key in band:
+                text(band, name_key, here)
+                number(band, limit_key, here, low=0.0, high=1.0)
     return table
 
 

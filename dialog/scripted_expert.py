@@ -40,8 +40,8 @@ import numpy as np
 
 from dialog.expert import ExpertView
 from learning.actions import Action, DemoQuery, FeatureQuery, NoQuery
+from learning.datafiles import check_keys, integer, number, read_toml, section
 from learning.decision_features import label_distribution
-from learning.toml_files import read_toml
 
 RULES_FILE = Path(__file__).parent / "data" / "scripted-expert.toml"
 
@@ -58,14 +58,15 @@ class ExpertRules:
     def load(cls, path: str | Path = RULES_FILE) -> ExpertRules:
         path = Path(path)
         data = read_toml(path, "scripted-expert rules")
-        try:
-            examples = data["examples"]
-            rules = cls(int(data["feature_query"]["by_turn"]), float(data["pace"]["head_start_turns"]),
-                        float(examples["uncertain_margin"]))
-        except (KeyError, TypeError, ValueError) as error:
-            raise ValueError(f"{path}: missing or malformed entry ({error}); see the comments in the file") from None
-        if rules.feature_query_by_turn < 1 or rules.head_start_turns < 0 or not 0 <= rules.uncertain_margin <= 1:
-            raise ValueError(f"{path}: by_turn >= 1, head_start_turns >= 0 and uncertain_margin in [0, 1] are required")
+        where = str(path)
+        check_keys(data, where, required=("feature_query", "pace", "examples"))
+        tables = {key: section(data, key, where) for key in ("feature_query", "pace", "examples")}
+        for key, field_name in (("feature_query", "by_turn"), ("pace", "head_start_turns"),
+                                ("examples", "uncertain_margin")):
+            check_keys(tables[key], f"{where} [{key}]", required=(field_name,))
+        rules = cls(integer(tables["feature_query"], "by_turn", f"{where} [feature_query]", low=1),
+                    number(tables["pace"], "head_start_turns", f"{where} [pace]", low=0.0),
+                    number(tables["examples"], "uncertain_margin", f"{where} [examples]", low=0.0, high=1.0))
         return rules
 
 

@@ -2,20 +2,29 @@
 
 from __future__ import annotations
 
-try:
-    import tomllib
-except ModuleNotFoundError:  # Python 3.10
-    import tomli as tomllib
 import re
 import unicodedata
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
 
+from learning.datafiles import MissingDataFileError, check_keys, read_toml, section
+from learning.errors import DataFileError
+
 VOCABULARY_FILE = Path(__file__).parent / "data" / "vocabulary.toml"
 MAX_ANSWER_CHARS = 300  # longer answers are refused before any matching is tried
 COMMANDS = ("help", "why", "undo", "skip", "quit", "dont_know")
 _SPLIT = re.compile(r"[^\w'#]+")
+# the answer grammar's pieces (docs/dialog.md, "The answer grammar")
+_PIECES = re.compile(r"[\s,;]+")
+_LEADING = "\"'\u00ab\u201c\u201e\u00bf\u00a1"  # opening quotes and marks, dropped before a word
+_TRAILING = ".,!?;:\"'\u00bb\u201d"  # sentence punctuation and closing quotes, dropped after a word
+_STOPS = frozenset(".!?")  # a piece made only of these ("...", "?!") is punctuation between words
+_WORD = re.compile(r"[^\W\d_]+(?:'[^\W\d_]+)*")
+_NUMBER = re.compile(r"#?([0-9]+)(?:st|nd|rd|th)?")
+_NUMBER_LIKE = re.compile(r"#?[-+\u2212\u00b1]?[0-9]*(?:[./:\u2044][0-9]+)*(?:e[-+]?[0-9]+)?(?:st|nd|rd|th|%)?")
+_BIDI = frozenset("\u061c\u200e\u200f\u202a\u202b\u202c\u202d\u202e\u2066\u2067\u2068\u2069")
+LARGEST_NUMBER = 10**9  # longer digit strings are read as this (out of every range)
 
 
 def clean(text: str) -> str:
@@ -29,6 +38,73 @@ def clean(text: str) -> str:
         elif category[0] != "C" and not unicodedata.combining(ch):
             kept.append(ch)
     return " ".join("".join(kept).casefold().split())
+
+
+@dataclass(frozen=True)
+class Token:
+    """One piece of a cleaned answer.
+
+    kind: "word" (letters, inner apostrophes), "number" (``value``: a whole
+    number as written, "4", "#4", "4th"), "mark" (a lone '#'), "bad_number"
+    (negative, fractional, exponent: "-1", "2.5", "1e3", "3/4") or "garbage"
+    (anything else: symbols, markup, digits inside words).
+    """
+
+    text: str
+    kind: str
+    value: int | None = None
+
+
+def _token(core: str) -> list[Token]:
+    match = _NUMBER.fullmatch(core)
+    if match:
+        digits = match.group(1)
+        return [Token(core, "number", int(digits) if len(digits) < 10 else LARGEST_NUMBER)]
+    if core == "#":
+        return [Token(core, "mark")]
+    if _WORD.fullmatch(core):
+        return [Token(core, "word")]
+    parts = re.split(r"[-_]", core)
+    if len(parts) > 1 and all(_WORD.fullmatch(part) for part in parts):  # main-dish, main_dish
+        return [Token(part, "word") for part in parts]
+    if any(ch.isdigit() for ch in core) and _NUMBER_LIKE.fullmatch(core):
+        return [Token(core, "bad_number")]
+    return [Token(core, "garbage")]
+
+
+def tokens(cleaned: str) -> list[Token]:
+    """The grammar's tokens of a cleaned answer: split at spaces, commas and semicolons; opening quotes before
+    and sentence punctuation after a piece are dropped, everything else stays and is classified."""
+    out: list[Token] = []
+    for piece in _PIECES.split(cleaned):
+        core = piece.lstrip(_LEADING).rstrip(_TRAILING)
+        if core:
+            out.extend(_token(core))
+        elif piece and not set(piece) <= _STOPS:
+            out.append(Token(piece, "garbage"))
+    return out
+
+
+def word_key(cleaned: str) -> str | None:
+    """A cleaned line as its words joined by spaces, or None when some token is not a word."""
+    pieces = tokens(cleaned)
+    return " ".join(t.text for t in pieces) if pieces and all(t.kind == "word" for t in pieces) else None
+
+
+def refused_characters(text: str) -> str | None:
+    """What makes a raw line unreadable before any matching: control, direction, surrogate or unassigned
+    characters (tabs and line ends are fine; invisible format characters such as zero-width spaces are dropped)."""
+    for ch in text:
+        if ch in "\t\n\r\v\f":
+            continue
+        category = unicodedata.category(ch)
+        if category == "Cc":
+            return f"a control character (U+{ord(ch):04X})"
+        if ch in _BIDI:
+            return f"a text-direction character (U+{ord(ch):04X})"
+        if category in ("Cs", "Co", "Cn"):
+            return f"an invalid or private character (U+{ord(ch):04X})"
+    return None
 
 
 def words(text: str) -> list[str]:
@@ -53,8 +129,12 @@ def plural(word_or_phrase: str) -> str:
     return f"{head} {last}".strip()
 
 
-class VocabularyError(ValueError):
+class VocabularyError(DataFileError):
     """The vocabulary file is missing or malformed."""
+
+
+VOCABULARY_TABLES = ("synonyms", "fillers", "negations", "commands", "absent", "confirm", "numbers", "features")
+OPTIONAL_TABLES = ("plurals", "connectives")
 
 
 @dataclass(frozen=True)
@@ -73,12 +153,15 @@ class Vocabulary:
     ignore_words: tuple[str, ...]
     use_words: tuple[str, ...]
     all_words: frozenset[str]
+    connectives: frozenset[str] = frozenset()  # words allowed between two named concepts ("fruit or snack")
 
     def command(self, text: str) -> str | None:
-        """The command a whole answer names ("why", "undo", ...), or None."""
-        key = phrase(text)
+        """The command a whole answer names ("why", "undo", ...), or None; every token must be a word
+        ("%s" is no "s")."""
+        cleaned = clean(text)
+        key = word_key(cleaned)
         for name in COMMANDS:
-            if key in self.commands[name] or clean(text) in self.commands[name]:
+            if key in self.commands[name] or cleaned in self.commands[name]:
                 return name
         return None
 
@@ -109,15 +192,15 @@ def load_vocabulary(path: str | Path = VOCABULARY_FILE) -> Vocabulary:
     """Read and check a vocabulary file; errors name the file and the table."""
     path = Path(path)
     try:
-        with open(path, "rb") as handle:
-            data = tomllib.load(handle)
-    except FileNotFoundError:
+        data = read_toml(path, "vocabulary")
+        check_keys(data, str(path), required=VOCABULARY_TABLES, optional=OPTIONAL_TABLES)
+        for table in VOCABULARY_TABLES + OPTIONAL_TABLES:
+            if table in data:
+                section(data, table, str(path))
+    except MissingDataFileError:
         raise VocabularyError(f"{path}: no such vocabulary file") from None
-    except tomllib.TOMLDecodeError as error:
-        raise VocabularyError(f"{path}: not valid TOML ({error})") from None
-    for table in ("synonyms", "fillers", "negations", "commands", "absent", "confirm", "numbers", "features"):
-        if not isinstance(data.get(table), dict):
-            raise VocabularyError(f"{path}: missing table [{table}]")
+    except DataFileError as error:
+        raise VocabularyError(str(error)) from None
     synonyms = {concept: _strings(data["synonyms"], concept, f"{path} [synonyms]") for concept in data["synonyms"]}
     plurals = {word: _strings(data.get("plurals", {}), word, f"{path} [plurals]") for word in data.get("plurals", {})}
     commands = {name: _normalised(_strings(data["commands"], name, f"{path} [commands]")) for name in COMMANDS}
@@ -140,4 +223,6 @@ def load_vocabulary(path: str | Path = VOCABULARY_FILE) -> Vocabulary:
         use_words=tuple(sorted((phrase(w) for w in _strings(features, "use", f"{path} [features]")),
                                key=lambda w: -len(w))),
         all_words=_normalised(_strings(features, "all", f"{path} [features]")),
+        connectives=_normalised(_strings(data["connectives"], "words", f"{path} [connectives]"))
+        if "connectives" in data else frozenset(),
     )

@@ -48,11 +48,7 @@ def weight_vector(weights: Mapping[str, float] | Sequence[float] | np.ndarray, s
 def load_weight_file(path: str | Path) -> np.ndarray:
     """w from a weights TOML file (read by ``learning.irl_weights``, the one reader of the format); a bad file
     gets a one-line message naming the file and what is accepted."""
-    try:
-        weights = load_weights(path)
-    except FileNotFoundError as error:
-        raise ValueError(str(error)) from None
-    return weight_vector(weights.as_dict(), str(path))
+    return weight_vector(load_weights(path).as_dict(), str(path))
 
 
 def preset_weights(name: str) -> np.ndarray:

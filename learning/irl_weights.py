@@ -22,14 +22,16 @@ from __future__ import annotations
 
 import json
 import math
+import os
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
+from learning.datafiles import read_toml
+from learning.errors import DataFileError
 from learning.irl_data import check_feature_names
-from learning.toml_files import read_toml
 
 WEIGHTS_TABLE = "weights"
 PROVENANCE_TABLE = "provenance"
@@ -117,7 +119,14 @@ def save_weights(path: str | Path, weights: DecisionWeights, comment: str = "") 
     path = Path(path)
     if path.suffix != ".toml":
         raise ValueError(f"{path}: a weights file must end in .toml")
-    path.write_text(weights_to_toml(weights, comment), encoding="utf-8")
+    # written beside the target and renamed over it: a failed write (a full disk) never leaves half a file
+    partial = path.with_name(f".{path.name}.partial")
+    try:
+        partial.write_text(weights_to_toml(weights, comment), encoding="utf-8")
+        os.replace(partial, path)
+    except BaseException:
+        partial.unlink(missing_ok=True)
+        raise
     return path
 
 
@@ -131,14 +140,14 @@ def weights_from_mapping(data: Mapping, feature_names: Sequence[str] | None = No
     """Validate parsed TOML (``[weights]`` and optional ``[provenance]``) into DecisionWeights."""
     unknown = sorted(set(data) - {WEIGHTS_TABLE, PROVENANCE_TABLE})
     if unknown:
-        raise ValueError(f"{source}: unknown table or key {unknown[0]!r}; accepted: [{WEIGHTS_TABLE}], "
+        raise DataFileError(f"{source}: unknown table or key {unknown[0]!r}; accepted: [{WEIGHTS_TABLE}], "
                          f"[{PROVENANCE_TABLE}]")
     table = data.get(WEIGHTS_TABLE)
     if not isinstance(table, Mapping) or not table:
-        raise ValueError(f"{source}: needs a non-empty [{WEIGHTS_TABLE}] table of feature = number")
+        raise DataFileError(f"{source}: needs a non-empty [{WEIGHTS_TABLE}] table of feature = number")
     for name, value in table.items():
         if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
-            raise ValueError(f"{source}: weight {name!r} must be a finite number, got {value!r}")
+            raise DataFileError(f"{source}: weight {name!r} must be a finite number, got {value!r}")
     try:
         names = check_feature_names(list(table), f"{source} [{WEIGHTS_TABLE}]")
         if feature_names is not None:
@@ -147,5 +156,5 @@ def weights_from_mapping(data: Mapping, feature_names: Sequence[str] | None = No
         provenance = _check_provenance(data.get(PROVENANCE_TABLE, {}), f"{source} [{PROVENANCE_TABLE}]")
     except ValueError as error:
         message = str(error)
-        raise ValueError(message if message.startswith(source) else f"{source}: {message}") from None
+        raise DataFileError(message if message.startswith(source) else f"{source}: {message}") from None
     return DecisionWeights(names, [float(table[name]) for name in names], provenance)

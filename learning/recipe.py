@@ -31,7 +31,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from learning.toml_files import read_toml
+from learning.datafiles import check_keys, read_toml
+from learning.errors import DataFileError
 
 PICK_PLACE = "pick-place"
 ACCEPTED_ACTIONS: tuple[str, ...] = (PICK_PLACE,)
@@ -88,32 +89,31 @@ def recipe_parameters(recipe: Recipe) -> RecipeParameters:
 
 
 def load_recipe(path: str | Path) -> Recipe:
-    """Read and validate a recipe TOML file; bad content raises a one-line ValueError."""
+    """Read and validate a recipe TOML file; bad content raises a one-line DataFileError (a ValueError)."""
     return recipe_from_mapping(read_toml(path, "recipe"), source=str(path))
 
 
 def recipe_from_mapping(data: dict[str, Any], source: str = "recipe") -> Recipe:
     """Build a Recipe from parsed TOML; ``source`` names the origin in error messages."""
     if not isinstance(data, dict):
-        raise ValueError(f"{source}: expected a table of fields, got {type(data).__name__}")
-    unknown = sorted(set(data) - set(RECIPE_FIELDS))
-    if unknown:
-        raise ValueError(f"{source}: unknown field {unknown[0]!r}; accepted fields: {', '.join(RECIPE_FIELDS)}")
+        raise DataFileError(f"{source}: expected a table of fields, got {type(data).__name__}")
+    check_keys(data, source, optional=RECIPE_FIELDS)
     name = _required_text(data, "name", source)
     description = data.get("description", "")
     if not isinstance(description, str):
-        raise ValueError(f"{source}: field 'description' must be a string, got {type(description).__name__}")
+        raise DataFileError(f"{source}: field 'description' must be a string, got {type(description).__name__}")
     if "step" not in data:
-        raise ValueError(f"{source}: missing field 'step'; a recipe needs at least one [[step]] table")
+        raise DataFileError(f"{source}: missing field 'step'; a recipe needs at least one [[step]] table")
     raw_steps = data["step"]
     if not isinstance(raw_steps, list) or not all(isinstance(s, dict) for s in raw_steps):
-        raise ValueError(f"{source}: field 'step' must be an array of [[step]] tables, got {type(raw_steps).__name__}")
+        raise DataFileError(f"{source}: field 'step' must be an array of [[step]] tables, "
+                            f"got {type(raw_steps).__name__}")
     if not raw_steps:
-        raise ValueError(f"{source}: field 'step' is empty; a recipe needs at least one step")
+        raise DataFileError(f"{source}: field 'step' is empty; a recipe needs at least one step")
     steps = tuple(_step_from_mapping(raw, f"{source}: step {number}") for number, raw in enumerate(raw_steps, start=1))
     problem = _first_problem_in_recipe(name, steps)
     if problem is not None:
-        raise ValueError(f"{source}: {problem}")
+        raise DataFileError(f"{source}: {problem}")
     return Recipe(name=name, description=description, steps=steps)
 
 
@@ -131,12 +131,10 @@ def load_builtin_recipe(name: str) -> Recipe:
 
 
 def _step_from_mapping(raw: dict[str, Any], where: str) -> RecipeStep:
-    unknown = sorted(set(raw) - set(STEP_FIELDS))
-    if unknown:
-        raise ValueError(f"{where}: unknown field {unknown[0]!r}; accepted fields: {', '.join(STEP_FIELDS)}")
+    check_keys(raw, where, optional=STEP_FIELDS)
     values = {field_name: _required_text(raw, field_name, where) for field_name in STEP_FIELDS}
     if values["action"] not in ACCEPTED_ACTIONS:
-        raise ValueError(
+        raise DataFileError(
             f"{where}: unknown action {values['action']!r}; accepted actions: {', '.join(ACCEPTED_ACTIONS)}"
         )
     return RecipeStep(**values)
@@ -144,14 +142,14 @@ def _step_from_mapping(raw: dict[str, Any], where: str) -> RecipeStep:
 
 def _required_text(mapping: dict[str, Any], field_name: str, where: str) -> str:
     if field_name not in mapping:
-        raise ValueError(f"{where}: missing field {field_name!r} (a non-empty string)")
+        raise DataFileError(f"{where}: missing field {field_name!r} (a non-empty string)")
     value = mapping[field_name]
     if not isinstance(value, str):
-        raise ValueError(
+        raise DataFileError(
             f"{where}: field {field_name!r} must be a non-empty string, got {type(value).__name__} {value!r}"
         )
     if not value.strip() or value != value.strip():
-        raise ValueError(
+        raise DataFileError(
             f"{where}: field {field_name!r} is {value!r}; accepted: a non-empty string without surrounding spaces"
         )
     return value

@@ -7,19 +7,29 @@ compared, and the thesis findings to test. See ``dialog/suites/README.md``.
 
 from __future__ import annotations
 
-try:
-    import tomllib
-except ModuleNotFoundError:  # Python 3.10
-    import tomli as tomllib
 from dataclasses import dataclass, field, replace
 from pathlib import Path
+
+from learning.actions import DEFAULT_COSTS
+from learning.datafiles import check_keys, integer, number, numbers, read_toml, section, tables, text, texts
+from learning.errors import DataFileError
+from learning.significance import ALTERNATIVES
 
 SUITE_DIR = Path(__file__).resolve().parents[1] / "suites"
 KINDS = ("episodes", "feature-selection", "recipes")
 AXES = ("questions", "turns", "demonstrations")
+SUITE_FIELDS = ("name", "description", "analysis", "kind", "task", "kitchen", "strategies", "datasets", "seeds",
+                "checkpoints", "axis", "costs", "teacher", "options", "dataset", "condition", "finding")
+CONDITION_FIELDS = ("name", "budget", "turns", "change_every")
+FINDING_FIELDS = ("id", "text", "condition", "at", "better", "than", "alternative", "than_at", "margin")
+TEACHER_KINDS = ("scripted", "oracle")
+TEACHER_RATES = ("mislabel_rate", "dont_know_rate", "feature_quality")
+PLAN_FIELDS = ("pools", "pool_size", "test_size", "objects_per_scene")
+FEATURE_OPTIONS = ("samples", "users", "relevant_features", "user_model")
+USER_MODEL_FIELDS = ("keep_relevant", "add_irrelevant", "ignore_robot", "ignore_irrelevant_object", "ignore_relevant")
 
 
-class SuiteError(ValueError):
+class SuiteError(DataFileError):
     """A suite file is missing, malformed, or asks for something that does not exist."""
 
 
@@ -91,15 +101,11 @@ def suite_names() -> list[str]:
     return sorted(p.stem for p in SUITE_DIR.glob("*.toml"))
 
 
-def _need(table: dict, key: str, kind, where: str):
-    if key not in table:
-        raise SuiteError(f"{where}: missing '{key}'")
-    value = table[key]
-    if kind is float and isinstance(value, int) and not isinstance(value, bool):
-        value = float(value)
-    if not isinstance(value, kind) or isinstance(value, bool):
-        raise SuiteError(f"{where}: '{key}' must be {getattr(kind, '__name__', kind)}, got {value!r}")
-    return value
+def _read(path: Path) -> dict:
+    try:
+        return read_toml(path, "suite")
+    except DataFileError as error:
+        raise SuiteError(str(error)) from None
 
 
 def load_suite(name_or_path: str | Path, known_strategies=None) -> Suite:
@@ -109,57 +115,109 @@ def load_suite(name_or_path: str | Path, known_strategies=None) -> Suite:
         path = SUITE_DIR / f"{name_or_path}.toml"
         if not path.exists():
             raise SuiteError(f"unknown suite '{name_or_path}'; available: {', '.join(suite_names())}")
-    try:
-        table = tomllib.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise SuiteError(f"{path}: no such file") from None
-    except tomllib.TOMLDecodeError as error:
-        raise SuiteError(f"{path}: not valid TOML ({error})") from None
+    table = _read(path)
     where = str(path)
-    kind = table.get("kind", "episodes")
-    if kind not in KINDS:
-        raise SuiteError(f"{where}: kind '{kind}' is not one of {', '.join(KINDS)}")
-    strategies = tuple(_need(table, "strategies", list, where))
+    try:
+        return _suite(table, where, known_strategies)
+    except SuiteError:
+        raise
+    except DataFileError as error:
+        raise SuiteError(str(error)) from None
+
+
+def _suite(table: dict, where: str, known_strategies) -> Suite:
+    check_keys(table, where, required=("name", "strategies", "checkpoints"), optional=SUITE_FIELDS)
+    kind = text(table, "kind", where, "episodes", choices=KINDS)
+    strategies = texts(table, "strategies", where, nonempty=True)
     if known_strategies is not None and kind == "episodes":
         unknown = [s for s in strategies if s not in known_strategies]
         if unknown:
             raise SuiteError(f"{where}: unknown strategies {unknown}; known: {', '.join(known_strategies)}")
-    conditions = tuple(
-        Condition(_need(c, "name", str, f"{where} condition {i + 1}"), _need(c, "budget", float, f"{where} "
-                  f"condition {i + 1}"), _need(c, "turns", int, f"{where} condition {i + 1}"),
-                  _need(c, "change_every", int, f"{where} condition {i + 1}"))
-        for i, c in enumerate(table.get("condition", []))
-    )
+    conditions = tuple(_condition(c, f"{where} condition {i + 1}") for i, c in enumerate(tables(table, "condition",
+                                                                                                 where, [])))
     if kind == "episodes" and not conditions:
         raise SuiteError(f"{where}: an episodes suite needs at least one [[condition]]")
     names = [c.name for c in conditions]
     if len(set(names)) != len(names):
         raise SuiteError(f"{where}: condition names must be unique, got {names}")
-    axis = table.get("axis", "questions")
-    if axis not in AXES:
-        raise SuiteError(f"{where}: axis '{axis}' is not one of {', '.join(AXES)}")
-    findings = []
-    for i, f in enumerate(table.get("finding", [])):
-        at = f"{where} finding {i + 1}"
-        default_condition = f"n{f.get('at')}" if kind == "feature-selection" else ""
-        finding = Finding(_need(f, "id", str, at), _need(f, "text", str, at), f.get("condition", default_condition),
-                          _need(f, "at", int, at), _need(f, "better", str, at), tuple(_need(f, "than", list, at)),
-                          f.get("alternative", "greater"), *_recipe_finding_extras(f, kind, at))
-        missing = [s for s in (finding.better, *finding.than) if s not in strategies]
-        if missing:
-            raise SuiteError(f"{at}: strategies {missing} are not in the suite's strategies")
-        if conditions and finding.condition not in names:
-            raise SuiteError(f"{at}: condition '{finding.condition}' is not one of {names}")
-        findings.append(finding)
+    findings = tuple(_finding(f, kind, strategies, names, f"{where} finding {i + 1}")
+                     for i, f in enumerate(tables(table, "finding", where, [])))
     return Suite(
-        name=_need(table, "name", str, where), description=table.get("description", ""), kind=kind,
-        task=table.get("task", "pack-lunchbox"), kitchen=table.get("kitchen", "kitchen-1"),
-        strategies=strategies, conditions=conditions, datasets=int(table.get("datasets", 5)),
-        seeds=tuple(table.get("seeds", [0])), checkpoints=tuple(_need(table, "checkpoints", list, where)),
-        axis=axis, costs=dict(table.get("costs", {})), teacher=dict(table.get("teacher", {})),
-        findings=tuple(findings), options=dict(table.get("options", {})), path=where,
-        dataset=dict(table.get("dataset", {})), analysis=str(table.get("analysis", "")),
+        name=text(table, "name", where), description=text(table, "description", where, "", nonempty=False),
+        kind=kind, task=text(table, "task", where, "pack-lunchbox"), kitchen=text(table, "kitchen", where, "kitchen-1"),
+        strategies=strategies, conditions=conditions, datasets=integer(table, "datasets", where, 5, low=1),
+        seeds=numbers(table, "seeds", where, (0,), whole=True, low=0),
+        checkpoints=numbers(table, "checkpoints", where, whole=True, low=0),
+        axis=text(table, "axis", where, "questions", choices=AXES), costs=_costs(table, where),
+        teacher=_teacher(table, where), findings=findings, options=_options(table, kind, where), path=where,
+        dataset=_plan(table, where), analysis=text(table, "analysis", where, "", nonempty=False),
     )
+
+
+def _condition(table: dict, where: str) -> Condition:
+    check_keys(table, where, required=CONDITION_FIELDS)
+    return Condition(text(table, "name", where), number(table, "budget", where, low=0.0),
+                     integer(table, "turns", where, low=1), integer(table, "change_every", where, low=1))
+
+
+def _finding(table: dict, kind: str, strategies: tuple, conditions: list, where: str) -> Finding:
+    check_keys(table, where, required=("id", "text", "at", "better", "than"), optional=FINDING_FIELDS)
+    at = integer(table, "at", where, low=0)
+    default_condition = f"n{at}" if kind == "feature-selection" else ""
+    finding = Finding(text(table, "id", where), text(table, "text", where),
+                      text(table, "condition", where, default_condition), at, text(table, "better", where),
+                      texts(table, "than", where, nonempty=True),
+                      text(table, "alternative", where, "greater", choices=ALTERNATIVES),
+                      *_recipe_finding_extras(table, kind, where))
+    missing = [s for s in (finding.better, *finding.than) if s not in strategies]
+    if missing:
+        raise SuiteError(f"{where}: strategies {missing} are not in the suite's strategies")
+    if conditions and finding.condition not in conditions:
+        raise SuiteError(f"{where}: condition '{finding.condition}' is not one of {conditions}")
+    return finding
+
+
+def _costs(table: dict, where: str) -> dict:
+    """The [costs] table: every action kind (label, demo, feature, none) with a finite cost >= 0."""
+    costs = section(table, "costs", where, None)
+    if costs is None:
+        return {}
+    check_keys(costs, f"{where} [costs]", required=tuple(DEFAULT_COSTS))
+    for kind in DEFAULT_COSTS:
+        number(costs, kind, f"{where} [costs]", low=0.0)
+    return {kind: costs[kind] for kind in DEFAULT_COSTS}  # as written (1 stays 1 in transcripts and baselines)
+
+
+def _teacher(table: dict, where: str) -> dict:
+    """The [teacher] table: kind (scripted or oracle) and the scripted teacher's rates, each 0..1."""
+    teacher, here = section(table, "teacher", where, {}), f"{where} [teacher]"
+    check_keys(teacher, here, optional=("kind", *TEACHER_RATES))
+    result = {"kind": text(teacher, "kind", here, choices=TEACHER_KINDS)} if "kind" in teacher else {}
+    return result | {key: number(teacher, key, here, low=0.0, high=1.0) for key in TEACHER_RATES if key in teacher}
+
+
+def _plan(table: dict, where: str) -> dict:
+    """The [dataset] table: overrides of the task's data-set plan, whole numbers >= 1."""
+    plan, here = section(table, "dataset", where, {}), f"{where} [dataset]"
+    check_keys(plan, here, optional=PLAN_FIELDS)
+    return {key: integer(plan, key, here, low=1) for key in plan}
+
+
+def _options(table: dict, kind: str, where: str) -> dict:
+    """[options]: none for episodes; the study's settings for feature-selection; recipes: see recipe_suite."""
+    options, here = section(table, "options", where, {}), f"{where} [options]"
+    if kind == "episodes":
+        check_keys(options, here)
+    elif kind == "feature-selection":
+        check_keys(options, here, optional=FEATURE_OPTIONS)
+        integer(options, "samples", here, 10, low=1)
+        integer(options, "users", here, 10, low=1)
+        texts(options, "relevant_features", here, ())
+        user_model = section(options, "user_model", here, {})
+        check_keys(user_model, f"{here} user_model", optional=USER_MODEL_FIELDS)
+        for key in user_model:
+            number(user_model, key, f"{here} user_model", low=0.0, high=1.0)
+    return dict(options)
 
 
 def _recipe_finding_extras(table: dict, kind: str, where: str) -> tuple[int | None, float]:
@@ -169,8 +227,4 @@ def _recipe_finding_extras(table: dict, kind: str, where: str) -> tuple[int | No
         if extra:
             raise SuiteError(f"{where}: '{extra[0]}' is only accepted in a suite of kind 'recipes'")
         return None, 0.0
-    than_at = _need(table, "than_at", int, where) if "than_at" in table else None
-    margin = _need(table, "margin", float, where) if "margin" in table else 0.0
-    if margin < 0:
-        raise SuiteError(f"{where}: 'margin' must be >= 0, got {margin}")
-    return than_at, margin
+    return integer(table, "than_at", where, None, low=0), number(table, "margin", where, 0.0, low=0.0)

@@ -75,7 +75,7 @@ def test_broken_task_files_name_the_field(tmp_path):
     text = open(base).read()
     path = tmp_path / "task.toml"
     path.write_text(text.replace('placement = "anywhere"', 'placement = "everywhere"'))
-    with pytest.raises(DataFileError, match="'placement' must be 'anywhere' or 'locations'"):
+    with pytest.raises(DataFileError, match="placement 'everywhere' is not one of anywhere, locations"):
         load_task(path)
     path.write_text(text.replace('"object/weight"]', '"object/smell"]'))
     with pytest.raises(DataFileError, match="'object/smell' names no feature"):

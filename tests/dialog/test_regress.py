@@ -58,7 +58,7 @@ def test_suite_errors_name_the_problem(tmp_path):
         load_suite("nope")
     with pytest.raises(SuiteError, match="unknown strategies \\['clever'\\]"):
         load_suite(write_suite(tmp_path, SUITE.replace('"active"]', '"clever"]')), ["passive", "active"])
-    with pytest.raises(SuiteError, match="missing 'budget'"):
+    with pytest.raises(SuiteError, match="missing field 'budget'"):
         load_suite(write_suite(tmp_path, SUITE.replace("budget = 3\n", "")))
     with pytest.raises(SuiteError, match="not in the suite's strategies"):
         load_suite(write_suite(tmp_path, SUITE.replace('than = ["active"]', 'than = ["random"]')))

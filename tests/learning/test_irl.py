@@ -241,3 +241,26 @@ def test_a_rollout_must_return_a_matching_episode(dt_expert):
         fit_feature_matching(train, lambda w, rng: other, config=FeatureMatchingConfig(max_iterations=1))
     with pytest.raises(ValueError, match="rollouts_per_iteration must be an integer >= 1"):
         FeatureMatchingConfig(rollouts_per_iteration=0)
+
+
+def test_a_failed_weights_write_keeps_the_old_file(tmp_path, monkeypatch):
+    """save_weights writes beside the file and renames: a full disk mid-write leaves the old weights whole."""
+    import pathlib
+
+    from learning.decision_weights import WEIGHTS_DIRECTORY
+    from learning.irl_weights import load_weights, save_weights
+
+    weights = load_weights(WEIGHTS_DIRECTORY / "dt.toml")
+    path = save_weights(tmp_path / "w.toml", weights)
+    before = path.read_text()
+
+    def full_disk(self, *args, **kwargs):
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(pathlib.Path, "write_text", full_disk)
+    with pytest.raises(OSError):
+        save_weights(path, weights, comment="new")
+    monkeypatch.undo()
+    assert path.read_text() == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["w.toml"]
+    assert load_weights(path).feature_names == weights.feature_names

@@ -1,0 +1,209 @@
+"""The one validation layer for teachbot's TOML data files (kitchen, task, objects, features, recipe, suite,
+weights, vocabulary, colour table, expert rules).
+
+:func:`read_toml` reads a file (refusing binary and non-UTF-8 files); the field checkers take the parsed
+table, a key and ``where`` (the file and section, e.g. ``"kitchen.toml [camera]"``) and either return a
+clean value or raise :class:`DataFileError` with one line naming the file, the field and what is accepted.
+Numbers must be finite (TOML allows ``nan`` and ``inf``); ``[low, high]`` ranges need low <= high; unknown
+keys list the accepted ones and suggest the nearest ("did you mean").
+"""
+
+from __future__ import annotations
+
+import difflib
+import math
+from collections.abc import Iterable
+from pathlib import Path
+
+from learning.errors import DataFileError
+
+try:
+    import tomllib
+except ModuleNotFoundError:  # Python 3.10
+    import tomli as tomllib
+
+__all__ = ["REQUIRED", "DataFileError", "MissingDataFileError", "check_keys", "flag", "integer", "number",
+           "numbers", "read_toml", "section", "tables", "text", "texts", "value_range"]
+
+
+class _Required:
+    def __repr__(self) -> str:
+        return "REQUIRED"
+
+
+REQUIRED = _Required()  # the default of a field that must be present
+
+
+class MissingDataFileError(DataFileError, FileNotFoundError):
+    """A data file does not exist (still a ValueError for the command line, and a FileNotFoundError)."""
+
+
+def read_toml(path: str | Path, what: str = "data") -> dict:
+    """The parsed TOML file; one-line DataFileError when it is missing, a folder, binary, not UTF-8 or not TOML."""
+    path = Path(path)
+    if not path.exists():
+        raise MissingDataFileError(f"{what} file {path} does not exist")
+    if not path.is_file():
+        raise DataFileError(f"{what} file {path} is not a file; give the path of a .toml file")
+    raw = path.read_bytes()
+    if b"\x00" in raw:
+        raise DataFileError(f"{path}: is a binary file, not a TOML {what} file")
+    try:
+        content = raw.decode("utf-8")
+    except UnicodeDecodeError as error:
+        raise DataFileError(f"{path}: is not UTF-8 text (byte {error.start}); a {what} file must be UTF-8 TOML") \
+            from None
+    try:
+        return tomllib.loads(content)
+    except tomllib.TOMLDecodeError as error:
+        raise DataFileError(f"{path}: not valid TOML ({error})") from None
+
+
+def check_keys(table: dict, where: str, required: Iterable[str] = (), optional: Iterable[str] = ()) -> None:
+    """Refuse a missing required key and any key not accepted (a typo gets "did you mean")."""
+    required, optional = tuple(required), tuple(optional)
+    if not isinstance(table, dict):
+        raise DataFileError(f"{where}: must be a table, got {_show(table)}")
+    accepted = tuple(dict.fromkeys(required + optional))  # each once, in order
+    for key in table:
+        if key not in accepted:
+            close = difflib.get_close_matches(str(key), accepted, n=1, cutoff=0.6)
+            hint = f" (did you mean '{close[0]}'?)" if close else ""
+            raise DataFileError(f"{where}: unknown field '{key}'; accepted fields: {', '.join(accepted) or 'none'}"
+                                f"{hint}")
+    missing = [key for key in required if key not in table]
+    if missing:
+        raise DataFileError(f"{where}: missing field '{missing[0]}' (required: {', '.join(required)})")
+
+
+def _show(value) -> str:
+    return f"{type(value).__name__} {value!r}" if not isinstance(value, (int, float, str)) else repr(value)
+
+
+def _present(table: dict, key: str, where: str, default):
+    """(True, value) when ``key`` is in the table, (False, default) when it may be left out."""
+    if key in table:
+        return True, table[key]
+    if default is REQUIRED:
+        raise DataFileError(f"{where}: missing field '{key}'")
+    return False, default
+
+
+def _is_number(value) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
+def _bounds(low, high, above, below) -> str:
+    parts = [f">= {low:g}" if low is not None else "", f"> {above:g}" if above is not None else "",
+             f"<= {high:g}" if high is not None else "", f"< {below:g}" if below is not None else ""]
+    return " and ".join(part for part in parts if part)
+
+
+def _check_number(value, label: str, where: str, whole: bool, low, high, above, below) -> float | int:
+    kind = "a whole number" if whole else "a finite number"
+    limits = _bounds(low, high, above, below)
+    good = (isinstance(value, int) and not isinstance(value, bool)) if whole else \
+        (_is_number(value) and math.isfinite(value))
+    if not good:
+        raise DataFileError(f"{where}: {label} must be {kind} {limits}".rstrip() + f", got {_show(value)}")
+    if (low is not None and value < low) or (high is not None and value > high) \
+            or (above is not None and value <= above) or (below is not None and value >= below):
+        raise DataFileError(f"{where}: {label} must be {limits}, got {value!r}")
+    return int(value) if whole else float(value)
+
+
+def number(table: dict, key: str, where: str, default=REQUIRED, low=None, high=None, above=None,
+           below=None) -> float:
+    """A finite number (int or float) within the inclusive ``low``/``high`` and exclusive ``above``/``below``."""
+    present, value = _present(table, key, where, default)
+    return _check_number(value, f"'{key}'", where, False, low, high, above, below) if present else value
+
+
+def integer(table: dict, key: str, where: str, default=REQUIRED, low=None, high=None) -> int:
+    """A whole number within ``low``..``high`` (inclusive)."""
+    present, value = _present(table, key, where, default)
+    return _check_number(value, f"'{key}'", where, True, low, high, None, None) if present else value
+
+
+def text(table: dict, key: str, where: str, default=REQUIRED, choices: Iterable[str] | None = None,
+         nonempty: bool = True) -> str:
+    """A string (non-empty unless told), one of ``choices`` when given."""
+    present, value = _present(table, key, where, default)
+    if not present:
+        return value
+    if not isinstance(value, str) or (nonempty and not value.strip()):
+        raise DataFileError(f"{where}: '{key}' must be a {'non-empty ' if nonempty else ''}string, got {_show(value)}")
+    if choices is not None and value not in tuple(choices):
+        raise DataFileError(f"{where}: {key} '{value}' is not one of {', '.join(choices)}")
+    return value
+
+
+def flag(table: dict, key: str, where: str, default=REQUIRED) -> bool:
+    """A boolean (``true`` or ``false``)."""
+    present, value = _present(table, key, where, default)
+    if present and not isinstance(value, bool):
+        raise DataFileError(f"{where}: '{key}' must be true or false, got {_show(value)}")
+    return value
+
+
+def numbers(table: dict, key: str, where: str, default=REQUIRED, length: int | None = None, low=None, high=None,
+            above=None, whole: bool = False, nonempty: bool = True) -> tuple:
+    """A list of finite numbers (whole numbers with ``whole``), of ``length`` items when given."""
+    present, value = _present(table, key, where, default)
+    if not present:
+        return value
+    size = f"{length} " if length is not None else ""
+    kind = "whole numbers" if whole else "numbers"
+    if not isinstance(value, list) or (length is not None and len(value) != length) or (nonempty and not value):
+        raise DataFileError(f"{where}: '{key}' must be a {'non-empty ' if nonempty and length is None else ''}"
+                            f"list of {size}{kind}, got {_show(value)}")
+    return tuple(_check_number(item, f"item {index + 1} of '{key}'", where, whole, low, high, above, None)
+                 for index, item in enumerate(value))
+
+
+def value_range(table: dict, key: str, where: str, default=REQUIRED, low=None, high=None) -> tuple[float, float]:
+    """``[low, high]``: two finite numbers, the first not above the second, both within the bounds."""
+    present, value = _present(table, key, where, default)
+    if not present:
+        return value
+    first, second = numbers(table, key, where, length=2, low=low, high=high)
+    if first > second:
+        raise DataFileError(f"{where}: '{key}' must be [low, high] with low <= high, got {[first, second]}")
+    return first, second
+
+
+def texts(table: dict, key: str, where: str, default=REQUIRED, nonempty: bool = False,
+          choices: Iterable[str] | None = None) -> tuple[str, ...]:
+    """A list of non-empty strings (at least one with ``nonempty``), each one of ``choices`` when given."""
+    present, value = _present(table, key, where, default)
+    if not present:
+        return tuple(value)
+    if not isinstance(value, list) or not all(isinstance(v, str) and v.strip() for v in value) \
+            or (nonempty and not value):
+        raise DataFileError(f"{where}: '{key}' must be a {'non-empty ' if nonempty else ''}list of names, "
+                            f"got {_show(value)}")
+    if choices is not None:
+        choices = tuple(choices)
+        unknown = [v for v in value if v not in choices]
+        if unknown:
+            raise DataFileError(f"{where}: '{key}' names '{unknown[0]}'; accepted: {', '.join(choices)}")
+    return tuple(value)
+
+
+def section(table: dict, key: str, where: str, default=REQUIRED) -> dict:
+    """A sub-table ``[key]`` (``default`` when absent and optional)."""
+    present, value = _present(table, key, where, default)
+    if present and not isinstance(value, dict):
+        raise DataFileError(f"{where}: '{key}' must be a table [{key}], got {_show(value)}")
+    return value
+
+
+def tables(table: dict, key: str, where: str, default=REQUIRED, nonempty: bool = False) -> list[dict]:
+    """An array of tables ``[[key]]``."""
+    present, value = _present(table, key, where, default)
+    if not present:
+        return list(value)
+    if not isinstance(value, list) or not all(isinstance(v, dict) for v in value) or (nonempty and not value):
+        raise DataFileError(f"{where}: '{key}' must be {'one or more' if nonempty else 'a list of'} [[{key}]] "
+                            f"tables, got {_show(value)}")
+    return value
