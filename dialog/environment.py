@@ -15,24 +15,17 @@ from typing import Protocol
 import numpy as np
 
 from bullet_world import Scene, World
+from bullet_world.pantry import Spot, free_spots, glimpse, object_poses, replacement_spots, restore_poses
+from bullet_world.world import HiddenObjectError
 from dialog.pictures import annotate_scene, project_points, save_picture
 from robot import Arm
 from robot.gestures import point_at
 
 PANTRY = "pantry"
-DEFAULT_RADIUS_M = 0.06  # footprint radius assumed for an object whose drawn size has no usable dimensions
-FETCH_CLEARANCE_M = 0.02  # free space kept around a fetched object's footprint
-FETCH_TRIES = 60
-
-
-def footprint_radius(draw: dict) -> float:
-    """Radius of the circle around a drawn object's footprint (box: half diagonal; round: its radius)."""
-    dims = draw.get("dimensions", {})
-    if "length" in dims and "width" in dims:
-        return 0.5 * float(np.hypot(dims["length"], dims["width"]))
-    if "radius" in dims:
-        return float(dims["radius"])
-    return DEFAULT_RADIUS_M
+FETCH_FREE_SPOTS = 2  # free pantry spots the robot tries (each costs one camera frame)
+FETCH_SPILL_M = 0.06  # how far beside the pantry region a fetched object may stand
+FETCH_REPLACEMENTS = 2  # objects of other concepts whose place a fetched object may take for a moment
+REACH_CLEARANCE_RADIUS_M = 0.15  # objects this close to the reach keep the hand above their tops
 
 
 class Environment(Protocol):
@@ -126,46 +119,58 @@ class SimulatedKitchen:
         allowed = getattr(self.world.task, "pantry_fetch", True)
         return bool(allowed) and PANTRY in self.world.kitchen.locations and concept in self.concepts
 
-    def _free_spot(self, scene: Scene, radius: float, rng: np.random.Generator):
-        region = self.world.kitchen.locations[PANTRY]
-        occupied = np.asarray(scene.positions, dtype=float)[:, :2]
-        if "size.length" in scene.feature_names:
-            others = scene.feature("size.length") / 2
-        else:
-            others = np.full(len(occupied), 0.06)
-        for _ in range(FETCH_TRIES):
-            xy = np.array([rng.uniform(region.centre[i] - region.half_size[i], region.centre[i] + region.half_size[i])
-                           for i in range(2)])
-            if np.all(np.linalg.norm(occupied - xy, axis=1) >= others + radius + FETCH_CLEARANCE_M):
-                return xy
-        return None
-
     def fetch(self, scene: Scene, concept: str, rng: np.random.Generator) -> dict | None:
-        """Reach into the pantry for an example of ``concept``, observe it, and put it back.
+        """Reach into the pantry for an example of ``concept``, show it to the camera, and put it back.
 
-        The world spawns a new object of one of the concept's kinds at a free
-        spot of the pantry region; its observed feature row is returned as
-        ``x``. None when the pantry region has no free spot.
+        The new object stands on a free spot of the pantry region the camera sees (or just beside it),
+        else in the place of a scene object of another concept, set aside for the moment; the scene is
+        left exactly as it was. Returns ``x`` (its observed feature row), ``kind``, ``position`` and
+        ``sim_seconds``; when no spot works, ``x`` is None and ``reason`` says why. None when the task
+        cannot fetch ``concept`` at all.
         """
         kinds = [k for k in getattr(self.world, "kinds", self.world.task.kinds) if k.concept == concept]
         if not kinds or not self.can_fetch(concept):
             return None
         kind = kinds[int(rng.integers(len(kinds)))]
         draw = kind.sample(rng)
-        xy = self._free_spot(scene, footprint_radius(draw), rng)
-        if xy is None:
-            return None
-        pantry = self.world.kitchen.locations[PANTRY].centre
-        reach = point_at(self.arm, pantry, 0.0)
-        self.arm.rest()
-        body = self.world.add_object(kind, xy, float(rng.uniform(0, np.pi)), draw=draw)
-        try:
-            observed = self.world.observe()
-            x = observed.X[-1].copy()
-        finally:
-            self.world.remove_object(body)
-        return {"x": x, "kind": kind.name, "position": [round(float(v), 4) for v in xy],
+        spots = self._fetch_spots(kind, draw, concept, rng)
+        if not spots:
+            return {"x": None, "kind": kind.name, "reason": "there is no room for it where the camera can see it"}
+        reach = self._reach_over(spots[0].xy)
+        for spot in spots:
+            try:
+                x = glimpse(self.world, kind, draw, spot)
+            except HiddenObjectError:
+                continue
+            result = {"x": x, "kind": kind.name, "position": [round(float(v), 4) for v in spot.xy],
+                      "sim_seconds": round(reach.sim_seconds, 3)}
+            if spot.replaces is not None:
+                result["replaced"] = self.world.objects[spot.replaces].kind.name
+            return result
+        return {"x": None, "kind": kind.name, "reason": "the camera could not see it wherever I put it",
                 "sim_seconds": round(reach.sim_seconds, 3)}
+
+    def _fetch_spots(self, kind, draw: dict, concept: str, rng: np.random.Generator) -> list[Spot]:
+        """Spots to try, best first: free ones in the pantry, one just beside it, then places of objects
+        of other concepts (nearest the pantry first)."""
+        world, region = self.world, self.world.kitchen.locations[PANTRY]
+        spots = free_spots(world, kind, draw, region, rng)[:FETCH_FREE_SPOTS]
+        spots += free_spots(world, kind, draw, region, rng, spill_m=FETCH_SPILL_M)[:1]
+        centre = np.asarray(region.centre[:2])
+        others = sorted((i for i, obj in enumerate(world.objects) if obj.kind.concept != concept),
+                        key=lambda i: float(np.linalg.norm(world.objects[i].xy - centre)))
+        return spots + replacement_spots(world, kind, draw, others)[:FETCH_REPLACEMENTS]
+
+    def _reach_over(self, xy: np.ndarray):
+        """The reaching gesture: the hand above ``xy``, clear of the tallest object nearby, then back to rest.
+        Any object the arm still nudged is put back where it stood."""
+        world = self.world
+        poses = object_poses(world)
+        near = [obj.size[2] for obj in world.objects if np.linalg.norm(obj.xy - xy) <= REACH_CLEARANCE_RADIUS_M]
+        reach = point_at(self.arm, np.array([xy[0], xy[1], 0.0]), max(near, default=0.0))
+        self.arm.rest()
+        restore_poses(world, poses)
+        return reach
 
     def close(self) -> None:
         self.world.close()

@@ -15,18 +15,53 @@ from learning.gp import BinaryGPClassifier
 RELATIVE_STD_FLOOR = 1e-3
 
 
+def checked_rows(X, n_features: int, what: str = "rows") -> np.ndarray:
+    """``X`` as a finite float (n, n_features) matrix; a ValueError naming the problem otherwise."""
+    try:
+        X = np.asarray(X, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"{what} must be numbers in an (n, {n_features}) matrix") from None
+    if X.ndim != 2 or X.shape[1] != n_features:
+        raise ValueError(f"{what} must be an (n, {n_features}) matrix, got shape {X.shape}")
+    bad = ~np.isfinite(X)
+    if bad.any():
+        row, column = (int(i) for i in np.argwhere(bad)[0])
+        raise ValueError(f"{what} must be finite numbers: {int(bad.sum())} value(s) are NaN or infinite, the first "
+                         f"at row {row}, column {column}")
+    return X
+
+
+def checked_row(x, n_features: int, what: str = "row") -> np.ndarray:
+    """``x`` as a finite float vector of ``n_features`` values; a ValueError naming the problem otherwise."""
+    try:
+        x = np.asarray(x, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"{what} must be {n_features} numbers") from None
+    if x.shape != (n_features,):
+        raise ValueError(f"{what} must hold {n_features} feature values, got shape {x.shape}")
+    return checked_rows(x[None, :], n_features, what)[0]
+
+
 class FeatureScaler:
     """Standardise features with the mean and spread of every instance observed so far."""
 
     def __init__(self, n_features: int):
+        self.n_features = int(n_features)
         self._sum = np.zeros(n_features)
         self._sq = np.zeros(n_features)
         self._count = 0
 
     def update(self, X: np.ndarray) -> None:
+        """Widen the pool with rows ``X`` (checked first: a bad matrix leaves the scaler unchanged)."""
+        X = checked_rows(X, self.n_features, "scaler rows")
         self._sum += X.sum(axis=0)
         self._sq += (X * X).sum(axis=0)
         self._count += len(X)
+
+    def copy(self) -> FeatureScaler:
+        twin = FeatureScaler(self.n_features)
+        twin._sum, twin._sq, twin._count = self._sum.copy(), self._sq.copy(), self._count
+        return twin
 
     @property
     def mean(self) -> np.ndarray:
@@ -42,6 +77,9 @@ class FeatureScaler:
         return np.where(spread > floor, spread, 1.0)
 
     def transform(self, X: np.ndarray) -> np.ndarray:
+        X = np.asarray(X, dtype=float)
+        if X.shape[-1:] != (self.n_features,):
+            raise ValueError(f"rows to scale must have {self.n_features} features, got shape {X.shape}")
         return (X - self.mean) / self.std
 
 
@@ -54,14 +92,36 @@ class ConceptModels:
         self.length_scale = length_scale
 
     def fit(self, X: np.ndarray, labels, subsets: dict[str, np.ndarray | None]) -> ConceptModels:
-        """Fit every concept on standardised rows ``X`` with concept names ``labels``."""
-        labels = np.asarray(labels, dtype=object)
+        """Fit every concept on standardised rows ``X`` with concept names ``labels``; everything is checked
+        before anything is replaced, so a bad call keeps the previous fit."""
+        X = np.asarray(X, dtype=float)
+        if X.ndim != 2:
+            raise ValueError(f"training rows must be a 2-D matrix, got shape {X.shape}")
+        X = checked_rows(X, X.shape[1], "training rows")
+        labels = np.asarray(labels, dtype=object).reshape(-1)
+        if len(labels) != len(X):
+            raise ValueError(f"{len(X)} training rows but {len(labels)} labels")
+        unknown = sorted({str(label) for label in labels} - set(self.concepts))
+        if unknown:
+            raise ValueError(f"unknown concept(s) {', '.join(unknown)}; known: {', '.join(self.concepts)}")
+        for concept, subset in subsets.items():
+            if subset is not None and len(subset):  # None or empty: all features
+                checked_subset(subset, X.shape[1], f"feature subset of '{concept}'")
+        previous = getattr(self, "subsets_", None)
         self.subsets_ = {c: subsets.get(c) for c in self.concepts}
-        self.models_ = {}
-        for concept in self.concepts:
-            columns = self.columns(concept, X.shape[1])
-            model = BinaryGPClassifier(self.length_scale, self.variance)
-            self.models_[concept] = model.fit(X[:, columns], labels == concept)
+        models = {}
+        try:
+            for concept in self.concepts:
+                columns = self.columns(concept, X.shape[1])
+                models[concept] = BinaryGPClassifier(self.length_scale, self.variance).fit(X[:, columns],
+                                                                                          labels == concept)
+        except Exception:
+            if previous is None:
+                del self.subsets_
+            else:
+                self.subsets_ = previous
+            raise
+        self.models_ = models
         return self
 
     def columns(self, concept: str, n_features: int) -> np.ndarray:
@@ -74,6 +134,21 @@ class ConceptModels:
         return np.column_stack([
             self.models_[c].predict_proba(X[:, self.columns(c, X.shape[1])]) for c in self.concepts
         ])
+
+
+def checked_subset(indices, n_features: int, what: str = "feature indices") -> np.ndarray:
+    """Sorted unique whole-number column indices, non-empty and within ``0..n_features - 1``."""
+    values = np.asarray(indices if np.ndim(indices) else [indices], dtype=object).reshape(-1)
+    if len(values) == 0:
+        raise ValueError(f"{what} must name at least one feature (indices 0..{n_features - 1})")
+    wrong = [v for v in values if isinstance(v, (bool, np.bool_)) or not isinstance(v, (int, np.integer))]
+    if wrong:
+        raise ValueError(f"{what} must be whole-number feature indices 0..{n_features - 1}, got {wrong[0]!r}")
+    values = np.unique(values.astype(int))
+    outside = values[(values < 0) | (values >= n_features)]
+    if len(outside):
+        raise ValueError(f"{what} must be within 0..{n_features - 1}, got {outside[0]}")
+    return values
 
 
 def normalise_rows(P: np.ndarray) -> np.ndarray:

@@ -7,7 +7,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from learning.actions import DEFAULT_COSTS, Action, validate_costs
-from learning.concepts import ConceptModels, FeatureScaler
+from learning.concepts import ConceptModels, FeatureScaler, checked_row, checked_rows, checked_subset
+
+SOURCES = ("label", "demo")  # how a training example may have been obtained
 
 
 @dataclass(frozen=True)
@@ -21,7 +23,11 @@ class Example:
 
 
 class LearningState:
-    """Everything a strategy may look at; the models are refit after every change."""
+    """Everything a strategy may look at; the models are refit after every change.
+
+    Every mutator checks its arguments before it changes anything: a bad call raises a ValueError
+    that names what was wrong and leaves the state exactly as it was.
+    """
 
     def __init__(self, concepts, feature_names, budget: float, turns: int, costs: dict | None = None,
                  change_every: int = 1, variance: float = 4.0, length_scale: float | None = None):
@@ -59,27 +65,49 @@ class LearningState:
     # -- the world ------------------------------------------------------------
     def observe_scene(self, scene_id: int, X: np.ndarray) -> None:
         """A new observation of the scene; a changed scene also widens the scaler's pool."""
-        X = np.asarray(X, dtype=float)
-        if X.ndim != 2 or X.shape[1] != len(self.feature_names):
-            raise ValueError(f"scene matrix must be (objects, {len(self.feature_names)}), got {X.shape}")
+        X = checked_rows(X, len(self.feature_names), f"scene {scene_id} matrix (objects x features)")
         if scene_id != self.scene_id:
+            previous = (self.scene_id, self.scene_X, self.asked_in_scene, self.demonstrated_in_scene,
+                        self.absent_in_scene, self.scaler)
             self.scene_id, self.scene_X = scene_id, X
             self.asked_in_scene = set()
             self.demonstrated_in_scene = set()
             self.absent_in_scene = set()
+            self.scaler = self.scaler.copy()
             self.scaler.update(X)
-            self.refit()
+            self._refit_or_restore(lambda: self._restore_scene(previous))
+
+    def _restore_scene(self, previous) -> None:
+        (self.scene_id, self.scene_X, self.asked_in_scene, self.demonstrated_in_scene, self.absent_in_scene,
+         self.scaler) = previous
 
     # -- answers ----------------------------------------------------------------
     def add_example(self, x: np.ndarray, concept: str, source: str) -> None:
+        """One more training instance: ``x`` (a row of feature values), its concept, and "label" or "demo"."""
         if concept not in self.concepts:
             raise ValueError(f"unknown concept '{concept}'; known: {', '.join(self.concepts)}")
-        x = np.asarray(x, dtype=float)
+        if source not in SOURCES:
+            raise ValueError(f"unknown example source '{source}'; accepted: {', '.join(SOURCES)}")
+        x = checked_row(x, len(self.feature_names), f"the example of '{concept}'")
+        shown = self._scene_rows_equal_to(x) if source == "demo" else set()
+        previous = (len(self.examples), set(self.demonstrated_in_scene), self.training_version)
         self.examples.append(Example(x, concept, source, self.scene_id))
-        if source == "demo":
-            self.demonstrated_in_scene.update(self._scene_rows_equal_to(x))
+        self.demonstrated_in_scene.update(shown)
         self.training_version += 1
-        self.refit()
+        self._refit_or_restore(lambda: self._restore_examples(*previous))
+
+    def _restore_examples(self, count: int, demonstrated: set[int], training_version: int) -> None:
+        del self.examples[count:]
+        self.demonstrated_in_scene, self.training_version = demonstrated, training_version
+
+    def _refit_or_restore(self, restore) -> None:
+        """Refit; if fitting fails (a bug or a numerical failure), undo the change and refit what was there."""
+        try:
+            self.refit()
+        except Exception:
+            restore()
+            self.refit()
+            raise
 
     def _scene_rows_equal_to(self, x: np.ndarray) -> set[int]:
         if x.shape != (len(self.feature_names),) or len(self.scene_X) == 0:
@@ -101,14 +129,14 @@ class LearningState:
 
     def set_feature_subset(self, indices) -> None:
         """Restrict every concept's classifier to the teacher's features from now on."""
-        indices = np.unique(np.asarray(indices, dtype=int))
-        if len(indices) == 0 or indices.min() < 0 or indices.max() >= len(self.feature_names):
-            raise ValueError(f"feature indices must be non-empty and within 0..{len(self.feature_names) - 1}")
+        indices = checked_subset(indices, len(self.feature_names), "feature indices")
+        previous = dict(self.feature_subsets)
         self.feature_subsets = {c: indices for c in self.concepts}
-        self.refit()
+        self._refit_or_restore(lambda: setattr(self, "feature_subsets", previous))
 
     def record_turn(self, action: Action) -> None:
         """Charge the action's cost and advance the clock."""
+        self.check_action(action)
         cost = self.cost(action)
         if cost > self.remaining_budget + 1e-9:
             raise ValueError(f"{action.kind} query costs {cost} but only {self.remaining_budget} is left")
@@ -125,9 +153,28 @@ class LearningState:
             self.last_query_scene_id = self.scene_id
         self.turn += 1
 
+    def check_action(self, action: Action) -> None:
+        """A ValueError unless ``action`` is a known kind that fits this state (object in the scene, known
+        concept)."""
+        kind = getattr(action, "kind", None)
+        if kind not in self.costs:
+            raise ValueError(f"unknown action {action!r}; accepted kinds: {', '.join(self.costs)}")
+        if kind == "label":
+            index = getattr(action, "object_index", None)
+            if isinstance(index, bool) or not isinstance(index, (int, np.integer)) \
+                    or not 0 <= index < len(self.scene_X):
+                raise ValueError(f"label query object {index!r} is not an object index of the current scene "
+                                 f"(0..{len(self.scene_X) - 1})")
+        if kind == "demo" and getattr(action, "concept", None) not in self.concepts:
+            raise ValueError(f"demonstration query concept {getattr(action, 'concept', None)!r} is not one of "
+                             f"{', '.join(self.concepts)}")
+
     # -- budget -------------------------------------------------------------------
     def cost(self, action: Action) -> float:
-        return self.costs[action.kind]
+        kind = getattr(action, "kind", None)
+        if kind not in self.costs:
+            raise ValueError(f"unknown action {action!r}; accepted kinds: {', '.join(self.costs)}")
+        return self.costs[kind]
 
     @property
     def remaining_budget(self) -> float:
@@ -178,7 +225,7 @@ class LearningState:
             if self._scene_P is None:
                 self._scene_P = self.models.predict(self.scaler.transform(self.scene_X))
             return self._scene_P
-        return self.models.predict(self.scaler.transform(np.asarray(X, dtype=float)))
+        return self.models.predict(self.scaler.transform(checked_rows(X, len(self.feature_names), "rows to predict")))
 
     def counts_per_concept(self) -> dict[str, int]:
         """Positive examples of each concept in the training set."""

@@ -278,3 +278,54 @@ def test_observers_hear_questions_and_answers(tmp_path):
                       say=lambda _: None, observers=[recorder]).run()
     assert recorder.events == [("question", "label", "What is "), ("answer", "label", "answer"),
                                ("question", "demo", "Can you "), ("answer", "demo", "absent")]
+
+
+class FailingPantry(PantryEnvironment):
+    """A pantry whose fetches come back empty-handed (no room, hidden) or with an unusable measurement."""
+
+    def __init__(self, result):
+        super().__init__(missing=("fruit",))
+        self.result = result
+
+    def fetch(self, scene, concept, rng):
+        self.fetched.append(concept)
+        return self.result
+
+
+@pytest.mark.parametrize("result, reason", [
+    ({"x": None, "kind": "peach", "reason": "the camera could not see it"}, "the camera could not see it"),
+    (None, "the pantry had none"),
+    ({"x": np.array([np.nan, 0.0, 0.0]), "kind": "peach"}, "my measurements of it were unusable"),
+    ({"x": np.zeros(5), "kind": "peach"}, "my measurements of it were unusable"),
+])
+def test_a_failed_fetch_is_told_recorded_as_absent_and_the_session_goes_on(tmp_path, result, reason):
+    teacher = LineTeacher(["none", "a snack", "none"])
+    actions = [DemoQuery("fruit"), LabelQuery(1), DemoQuery("fruit")]
+    manager = manager_for(tmp_path / "t.jsonl", FailingPantry(result), teacher, ScriptedStrategy(actions), turns=4,
+                          budget=10)
+    outcome = manager.run()
+    records = read_transcript(tmp_path / "t.jsonl")
+    assert outcome.completed == 4 and len(records) == 4
+    failed = [r for r in records if "fetch_failed" in r]
+    assert [r["turn"] for r in failed] == [1, 3] and all(r["answer"]["kind"] == "absent" for r in failed)
+    assert all(reason in r["fetch_failed"]["reason"] and "fetched" not in r for r in failed)
+    assert sum("I couldn't fetch one from the pantry" in line and reason in line for line in teacher.heard) == 2
+    assert manager.state.counts_per_concept() == {"main dish": 0, "snack": 1, "fruit": 0, "beverage": 0}
+    assert records[2]["scene_id"] == records[0]["scene_id"] and "fruit" in manager.state.absent_in_scene
+
+
+def test_a_recorded_failed_fetch_replays_on_resume(tmp_path):
+    def pantry():
+        return FailingPantry({"x": None, "kind": "peach", "reason": "no room"})
+
+    actions = [DemoQuery("fruit"), LabelQuery(1), NoQuery()]
+    first = manager_for(tmp_path / "t.jsonl", pantry(), LineTeacher(["none", "a snack"]), ScriptedStrategy(actions),
+                        turns=3, budget=10)
+    first.run()
+    first.transcript.close()
+    records = read_session(tmp_path / "t.jsonl")[1]
+    assert "fetch_failed" in records[0]
+    resumed = DialogManager(pantry(), LineTeacher([]), ScriptedStrategy(actions), EpisodeConfig(turns=3, budget=10),
+                            TranscriptWriter(tmp_path / "u.jsonl"), episode_generators(0), say=lambda _: None)
+    result = resumed.run(replay=records)
+    assert result.completed == 3 and resumed.state.counts_per_concept() == first.state.counts_per_concept()
