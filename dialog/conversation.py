@@ -75,6 +75,9 @@ def converse(teacher, prompt: Prompt, parser: AnswerParser, clock) -> Outcome:
         if late:
             return Outcome("late", None, lines, now - started)
         reading = parser.choice(line, choices) if choices else read_line(prompt, parser, line)
+        if len(lines) >= MAX_LINES_PER_QUESTION and reading.kind in ("help", "why", "unreadable", "reject", "choose"):
+            teacher.tell(f"({len(lines)} answers without one I could take: I'll skip this question.)")
+            return Outcome("skip", None, lines, clock.now() - started, "too many unreadable answers")
         if reading.kind == "help":
             teacher.tell(help_text(prompt) if not choices else
                          "Type the number of the one you meant, or 'no' to answer the question again.")
@@ -95,6 +98,3 @@ def converse(teacher, prompt: Prompt, parser: AnswerParser, clock) -> Outcome:
             if note.startswith("("):  # a typo read as a concept: say so, so that the teacher can undo it
                 teacher.tell(note)
             return Outcome(reading.kind, reading.value, lines, clock.now() - started, note)
-        if len(lines) >= MAX_LINES_PER_QUESTION:
-            teacher.tell("I'll skip this question.")
-            return Outcome("skip", None, lines, clock.now() - started, "too many unreadable answers")

@@ -12,9 +12,10 @@ import re
 from dataclasses import dataclass, field
 
 from dialog.parsing import Reading
-from dialog.vocabulary import MAX_ANSWER_CHARS, Vocabulary, clean, load_vocabulary, phrase
+from dialog.vocabulary import MAX_ANSWER_CHARS, Vocabulary, clean, load_vocabulary, phrase, refused_characters, word_key
 
 _NUMBER = re.compile(r"^\d{1,3}(\.\d{1,3})*$")
+_PLAIN_WORDS = ("feature", "features", "group", "groups")
 _RANGE = re.compile(r"^(\d{1,3}(?:\.\d{1,3})*)-(\d{1,3}(?:\.\d{1,3})*)$")
 
 
@@ -122,6 +123,8 @@ class FeatureTree:
         first, last = start.split("."), end.split(".")
         if len(first) != len(last) or first[:-1] != last[:-1] or int(first[-1]) > int(last[-1]):
             return None
+        if start not in self.by_number or end not in self.by_number:  # both ends must be in the tree
+            return None
         prefix = ".".join(first[:-1])
         numbers = [f"{prefix}.{k}" if prefix else str(k) for k in range(int(first[-1]), int(last[-1]) + 1)]
         return [self.by_number[n] for n in numbers if n in self.by_number] or None
@@ -134,7 +137,10 @@ class FeatureTree:
                     "'don't know', 'skip', 'why', 'undo', 'help' or 'quit'.")
         if len(text) > MAX_ANSWER_CHARS:
             return Reading("unreadable", message=f"That answer is too long ({len(text)} characters; at most "
-                                                 f"{MAX_ANSWER_CHARS}).")
+                                                 f"{MAX_ANSWER_CHARS}). {accepted}")
+        odd = refused_characters(text)
+        if odd:
+            return Reading("unreadable", message=f"That answer holds {odd}; please type plain text. {accepted}")
         command = vocabulary.command(text)
         if command:
             return Reading(command)
@@ -155,7 +161,7 @@ class FeatureTree:
         items = [item for item in items if item]
         selected: set[int] = set()
         unknown: list[str] = []
-        if phrase(body) in vocabulary.all_words:
+        if word_key(body) in vocabulary.all_words:
             selected = set(range(len(self.feature_names)))
             items = []
         for item in items:
@@ -167,15 +173,17 @@ class FeatureTree:
             else:
                 nodes = self._by_name(item) or None
             if nodes is None:
-                if phrase(item) in vocabulary.fillers or phrase(item) in ("feature", "features", "group", "groups"):
+                if word_key(item) in vocabulary.fillers or word_key(item) in _PLAIN_WORDS:
                     continue
                 unknown.append(item[:30])
                 continue
             for node in nodes:
                 selected.update(node.leaves())
         if unknown:
+            numbered = (f" (the groups are numbered 1 to {len(self.roots)}, as listed)"
+                        if any(ch.isdigit() for u in unknown for ch in u) else "")
             return Reading("unreadable", message=f"I don't know {', '.join(repr(u) for u in unknown[:5])} in the "
-                                                 f"feature list. {accepted}")
+                                                 f"feature list{numbered}. {accepted}")
         if not selected:
             return Reading("unreadable", message=f"That names no feature. {accepted}")
         if mode == "ignore":

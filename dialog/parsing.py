@@ -1,19 +1,31 @@
-"""Tolerant reading of the teacher's answers: concept names, object numbers, commands, confirmations.
+"""Reading the teacher's answers by one grammar: concept names, object numbers, commands, confirmations.
 
-Nothing is guessed: an answer is read as a value only when the vocabulary or a
-small typo distance makes it unambiguous; two close candidates lead to a
-question back ("did you mean ...?"); anything else is refused with a message
-that lists the accepted forms, and the robot asks again.
+Nothing is guessed: a line is taken only when every token of it is consumed by
+the grammar (fillers, number markers, one number or one concept, the concept's
+own words for a demonstration; a command is a whole line). Two close
+candidates lead to a question back ("did you mean ...?"); anything else is
+refused with a message that says what was wrong and lists the accepted forms.
+The grammar is written down in docs/dialog.md ("The answer grammar").
 """
 
 from __future__ import annotations
 
-import re
 from dataclasses import dataclass
 
-from dialog.vocabulary import MAX_ANSWER_CHARS, Vocabulary, clean, load_vocabulary, phrase, plural, words
+from dialog.vocabulary import (
+    MAX_ANSWER_CHARS,
+    Token,
+    Vocabulary,
+    clean,
+    load_vocabulary,
+    phrase,
+    plural,
+    refused_characters,
+    tokens,
+    word_key,
+)
 
-_DIGITS = re.compile(r"^#?(\d{1,6})(?:st|nd|rd|th)?$")
+COMMAND_FORMS = "'don't know', 'skip', 'why', 'undo', 'help' or 'quit'"
 
 
 @dataclass(frozen=True)
@@ -68,53 +80,108 @@ class AnswerParser:
             for form in self.vocabulary.forms(concept):
                 self.form_owners.setdefault(form, set()).add(concept)
         for concept in self.concepts:  # a concept's own name always means that concept
-            for form in (phrase(concept),):
-                self.form_owners[form] = {concept}
+            self.form_owners[phrase(concept)] = {concept}
         self._longest_form = max((len(f.split()) for f in self.form_owners), default=1)
+        self._absent = {tuple(p.split()) for p in self.vocabulary.absent}
+        self._longest_absent = max((len(p) for p in self._absent), default=1)
         # typos are matched against the concept names and their plurals only, never against synonyms
         self.name_forms = {c: {phrase(c), phrase(plural(c))} | {phrase(p) for p in self.vocabulary.plurals.get(c, ())}
                            for c in self.concepts}
 
-    # -- shared ---------------------------------------------------------------------
-    def _precheck(self, text: str) -> Reading | None:
-        if len(text) > MAX_ANSWER_CHARS:
-            return Reading("unreadable", message=f"That answer is too long ({len(text)} characters; "
-                                                 f"at most {MAX_ANSWER_CHARS}).")
-        if not phrase(text) and clean(text) not in self.vocabulary.commands["help"]:
-            return Reading("unreadable", message="I got an empty answer." if not clean(text) else
-                           f"I can't read '{clean(text)[:40]}'.")
-        command = self.vocabulary.command(text)
-        return Reading(command) if command else None
-
+    # -- accepted forms, said with every refusal ------------------------------------------
     def concept_list(self) -> str:
         return ", ".join(f"{i + 1} {c}" for i, c in enumerate(self.concepts))
 
-    def _number_words(self, tokens: list[str]) -> list[int]:
-        """Object numbers in the words: digits, '#4', '4th', number words after a marker or on their own."""
-        vocabulary = self.vocabulary
-        numbers = []
-        for position, token in enumerate(tokens):
-            match = _DIGITS.match(token)
-            if match:
-                numbers.append(int(match.group(1)))
-            elif token in vocabulary.ordinals:
-                numbers.append(vocabulary.ordinals.index(token))
-            elif token in vocabulary.cardinals:
-                marked = position > 0 and tokens[position - 1] in vocabulary.number_markers
-                if marked or len(tokens) == 1 or token != "one":
-                    numbers.append(vocabulary.cardinals.index(token))
-        return numbers
+    def label_forms(self) -> str:
+        return (f"Please name one of: {', '.join(self.concepts)} (or its number: {self.concept_list()}); "
+                f"or say {COMMAND_FORMS}.")
 
-    # -- label queries ----------------------------------------------------------------
-    def concepts_mentioned(self, tokens: list[str]) -> set[str]:
-        """Concepts named exactly by some run of words (longest forms first)."""
-        found: set[str] = set()
-        for size in range(min(self._longest_form, len(tokens)), 0, -1):
-            for start in range(len(tokens) - size + 1):
-                owners = self.form_owners.get(" ".join(tokens[start:start + size]))
+    @staticmethod
+    def demonstration_forms(n_objects: int, concept: str) -> str:
+        return (f"Please give the number of a {concept} (1 to {n_objects}), or say 'none' if there is no "
+                f"{concept} here; or {COMMAND_FORMS}.")
+
+    @staticmethod
+    def choice_forms(choices: tuple[str, ...]) -> str:
+        return ("Type " + " or ".join(f"{i + 1} for {c}" for i, c in enumerate(choices))
+                + (", yes or no." if len(choices) == 1 else ", or 'no' to answer the question again."))
+
+    # -- shared ---------------------------------------------------------------------
+    def _precheck(self, text: str, accepted: str) -> tuple[Reading | None, list[Token]]:
+        """Too long, odd characters, empty, or a command: the reading; else the line's tokens."""
+        if len(text) > MAX_ANSWER_CHARS:
+            return Reading("unreadable", message=f"That answer is too long ({len(text)} characters; "
+                                                 f"at most {MAX_ANSWER_CHARS}). {accepted}"), []
+        odd = refused_characters(text)
+        if odd:
+            return Reading("unreadable", message=f"That answer holds {odd}; please type plain text. {accepted}"), []
+        cleaned = clean(text)
+        if not cleaned:
+            return Reading("unreadable", message=f"I got an empty answer. {accepted}"), []
+        command = self.vocabulary.command(text)
+        if command:
+            return Reading(command), []
+        pieces = tokens(cleaned)
+        if not pieces:
+            return Reading("unreadable", message=f"I can't read '{cleaned[:40]}'. {accepted}"), []
+        return None, pieces
+
+    @staticmethod
+    def _odd_tokens(pieces: list[Token], accepted: str, what: str, high: int) -> Reading | None:
+        """Symbols, markup or a number that is not a whole positive number: refused, the range named."""
+        garbage = [t.text for t in pieces if t.kind == "garbage"]
+        if garbage:
+            return Reading("unreadable", message=f"I can't read {_quoted(garbage)} in that answer. {accepted}")
+        bad = [t.text for t in pieces if t.kind == "bad_number"]
+        if bad:
+            return Reading("unreadable", message=f"I can't take {_quoted(bad)}: {what}s are whole numbers "
+                                                 f"from 1 to {high}. {accepted}")
+        return None
+
+    def _number(self, pieces: list[Token], position: int) -> int | None:
+        """The number token ``position`` holds: digits ('4', '#4', '4th') or a number word ('four', 'fourth')."""
+        token = pieces[position]
+        if token.kind == "number":
+            return token.value
+        if token.kind != "word":
+            return None
+        if token.text in self.vocabulary.ordinals:
+            return self.vocabulary.ordinals.index(token.text)
+        if token.text in self.vocabulary.cardinals:
+            marked = position > 0 and self._is_marker(pieces, position - 1)
+            if token.text != "one" or marked or len(pieces) == 1:  # "that one" is a filler, "number one" is 1
+                return self.vocabulary.cardinals.index(token.text)
+        return None
+
+    def _is_marker(self, pieces: list[Token], position: int) -> bool:
+        token = pieces[position]
+        return token.kind == "mark" or (token.kind == "word" and token.text in self.vocabulary.number_markers)
+
+    def _segment(self, pieces: list[Token]) -> tuple[list[set[str]], list[Token]]:
+        """Concept forms (longest first, left to right), fillers, and the tokens left over."""
+        named: list[set[str]] = []
+        leftover: list[Token] = []
+        position = 0
+        while position < len(pieces):
+            for size in range(min(self._longest_form, len(pieces) - position), 0, -1):
+                run = pieces[position:position + size]
+                owners = self.form_owners.get(" ".join(t.text for t in run)) if all(
+                    t.kind == "word" for t in run) else None
                 if owners:
-                    found |= owners
-        return found
+                    named.append(owners)
+                    position += size
+                    break
+            else:
+                token = pieces[position]
+                if not (token.kind == "word" and token.text in self.vocabulary.fillers):
+                    leftover.append(token)
+                position += 1
+        return named, leftover
+
+    def concepts_mentioned(self, words_of_answer: list[str]) -> set[str]:
+        """Concepts named by forms in a list of words (longest forms first)."""
+        named, _ = self._segment([Token(w, "word") for w in words_of_answer])
+        return set().union(*named) if named else set()
 
     def _fuzzy(self, candidates: list[str]) -> dict[str, int]:
         """Best typo distance per concept over the candidate strings (within each form's tolerance + 1)."""
@@ -130,97 +197,150 @@ class AnswerParser:
                         best[concept] = distance
         return best
 
+    # -- label queries ----------------------------------------------------------------
     def label(self, text: str) -> Reading:
         """A concept name for a label query ("a fruit", "Fruits", "frut", "3" from the numbered list)."""
-        early = self._precheck(text)
+        accepted = self.label_forms()
+        early, pieces = self._precheck(text, accepted)
         if early:
             return early
-        accepted = (f"Please name one of: {', '.join(self.concepts)} (or its number: {self.concept_list()}); "
-                    "or say 'don't know', 'skip', 'why', 'undo', 'help' or 'quit'.")
-        tokens = words(clean(text))
-        if any(t in self.vocabulary.negations for t in tokens):
+        odd = self._odd_tokens(pieces, accepted, "concept number", len(self.concepts))
+        if odd:
+            return odd
+        shown = clean(text)[:60]
+        if any(t.text in self.vocabulary.negations for t in pieces):
             return Reading("unreadable", message=f"I can only learn what it is, not what it isn't. {accepted}")
-        content = [t for t in tokens if t not in self.vocabulary.fillers]
-        mentioned = self.concepts_mentioned(tokens)
-        if len(mentioned) == 1:
-            return Reading("answer", mentioned.pop())
-        if len(mentioned) > 1:
-            choices = tuple(c for c in self.concepts if c in mentioned)
-            return Reading("choose", choices=choices, message=f"You named {' and '.join(choices)}.")
-        numbers = self._number_words(content) if len(content) == 1 else []
-        if numbers:
-            if 1 <= numbers[0] <= len(self.concepts):
-                return Reading("answer", self.concepts[numbers[0] - 1])
-            return Reading("unreadable", message=f"There is no concept number {numbers[0]}. {accepted}")
-        if not content or len(" ".join(content)) > 60:
-            return Reading("unreadable", message=f"I didn't understand '{clean(text)[:60]}'. {accepted}")
-        candidates = [" ".join(content)] + [" ".join(content[i:i + n]) for n in (1, 2, 3)
-                                            for i in range(len(content) - n + 1)]
-        best = self._fuzzy(list(dict.fromkeys(candidates)))
-        if best:
-            top = min(best.values())
-            close = tuple(c for c in self.concepts if c in best and best[c] <= top + 1)
-            if len(close) == 1 and top <= typo_tolerance(close[0]):
-                return Reading("answer", close[0], message=f"(I take '{' '.join(content)}' as '{close[0]}'.)")
-            if close:
-                return Reading("choose", choices=close, message=f"'{' '.join(content)}' is close to more than "
+        named, leftover = self._segment(pieces)
+        mentioned = tuple(c for c in self.concepts if any(c in owners for owners in named))
+        if mentioned:
+            if len(mentioned) == 1 and not leftover:
+                return Reading("answer", mentioned[0])
+            if len(mentioned) > 1 and all(t.text in self.vocabulary.connectives for t in leftover):
+                return Reading("choose", choices=mentioned, message=f"You named {' and '.join(mentioned)}.")
+            return Reading("unreadable", message=f"{_not_understood(shown, leftover)} {accepted}")
+        if len(leftover) == 1 and leftover[0].kind in ("number", "word"):
+            number = self._number(leftover, 0)
+            if number is not None:
+                if 1 <= number <= len(self.concepts):
+                    return Reading("answer", self.concepts[number - 1])
+                return Reading("unreadable", message=f"There is no concept number {_shown_number(leftover[0])} "
+                                                     f"(they are numbered 1 to {len(self.concepts)}). {accepted}")
+        content = " ".join(t.text for t in leftover)
+        if leftover and all(t.kind == "word" for t in leftover) and len(content) <= 60:
+            best = self._fuzzy([content])
+            if best:
+                top = min(best.values())
+                close = tuple(c for c in self.concepts if c in best and best[c] <= top + 1)
+                if len(close) == 1 and top <= typo_tolerance(close[0]):
+                    return Reading("answer", close[0], message=f"(I take '{content}' as '{close[0]}'.)")
+                return Reading("choose", choices=close, message=f"'{content}' is close to more than "
                                                                 "one word I know." if len(close) > 1 else "")
-        return Reading("unreadable", message=f"I didn't understand '{clean(text)[:60]}'. {accepted}")
+        return Reading("unreadable", message=f"I didn't understand '{shown}'. {accepted}")
 
     # -- demonstration queries ---------------------------------------------------------
     def demonstration(self, text: str, n_objects: int, concept: str) -> Reading:
         """An object number ("4", "number four", "the 4th") or "none" when no example is in the scene."""
-        early = self._precheck(text)
+        accepted = self.demonstration_forms(n_objects, concept)
+        early, pieces = self._precheck(text, accepted)
         if early:
             return early
-        accepted = (f"Please give the number of a {concept} (1 to {n_objects}), or say 'none' if there is no "
-                    f"{concept} here; or 'don't know', 'skip', 'why', 'undo', 'help' or 'quit'.")
-        tokens = words(clean(text))
-        concept_words = set(phrase(concept).split())
-        for form, owners in self.form_owners.items():
-            if concept in owners:
-                concept_words.update(form.split())
-        remainder = [t for t in tokens if t not in self.vocabulary.fillers and t not in concept_words]
-        markers = self.vocabulary.number_markers
-        negated = [t in self.vocabulary.negations and not (t in markers and i + 1 < len(tokens)
-                                                           and self._number_words([tokens[i + 1]]))
-                   for i, t in enumerate(tokens)]
-        numbers = self._number_words([t for t, negation in zip(tokens, negated) if not negation])
-        joined = " ".join(remainder)
-        whole = " ".join(t for t in tokens if t not in concept_words)
-        if not numbers and (joined in self.vocabulary.absent or whole in self.vocabulary.absent
-                            or (remainder and remainder[0] in ("no", "none") and len(remainder) <= 3)):
-            return Reading("absent")
-        if any(negated):
+        odd = self._odd_tokens(pieces, accepted, "object number", n_objects)
+        if odd:
+            return odd
+        concept_words = {word for form, owners in self.form_owners.items() if concept in owners
+                         for word in form.split()} | set(phrase(concept).split())
+        consumed = [False] * len(pieces)
+        numbers: list[tuple[int, Token]] = []
+        for position in range(len(pieces)):
+            number = self._number(pieces, position)
+            if number is not None:
+                numbers.append((number, pieces[position]))
+                consumed[position] = True
+                if position > 0 and self._is_marker(pieces, position - 1):
+                    consumed[position - 1] = True
+        absent = self._mark_absent(pieces, [i for i in range(len(pieces)) if not consumed[i]], consumed)
+        rest = [i for i, t in enumerate(pieces) if not consumed[i] and t.text not in concept_words]
+        absent += self._mark_absent(pieces, rest, consumed)  # "there is no fruit here"
+        vocabulary = self.vocabulary
+        leftover = [pieces[i] for i in rest if not consumed[i] and pieces[i].text not in vocabulary.fillers]
+        if numbers and any(t.text in vocabulary.negations for t in leftover):
             return Reading("unreadable", message=f"Please tell me which one it is, not which it isn't. {accepted}")
-        if len(set(numbers)) > 1:
-            return Reading("unreadable", message=f"One number please, you gave {sorted(set(numbers))}. {accepted}")
+        distinct = sorted({n for n, _ in numbers})
+        if len(distinct) > 1:
+            return Reading("unreadable", message=f"One number please, you gave {distinct[:5]}. {accepted}")
+        if leftover:
+            return Reading("unreadable", message=f"{_not_understood(clean(text)[:60], leftover)} {accepted}")
+        if numbers and absent:
+            return Reading("unreadable", message=f"You gave a number and said there is none. {accepted}")
         if numbers:
-            number = numbers[0]
+            number, token = numbers[0]
             if not 1 <= number <= n_objects:
-                return Reading("unreadable", message=f"There is no object {number} in this scene. {accepted}")
+                return Reading("unreadable", message=f"There is no object {_shown_number(token)} in this scene "
+                                                     f"(they are numbered 1 to {n_objects}). {accepted}")
             return Reading("answer", number - 1)
+        if absent:
+            return Reading("absent")
         return Reading("unreadable", message=f"I didn't understand '{clean(text)[:60]}'. {accepted}")
+
+    def _mark_absent(self, pieces: list[Token], positions: list[int], consumed: list[bool]) -> int:
+        """Mark runs of ``positions`` that read as an absent phrase ("there is no", "not here"); how many."""
+        runs, index = 0, 0
+        while index < len(positions):
+            for size in range(min(self._longest_absent, len(positions) - index), 0, -1):
+                run = positions[index:index + size]
+                if tuple(pieces[i].text for i in run) in self._absent:
+                    for i in run:
+                        consumed[i] = True
+                    runs += 1
+                    index += size
+                    break
+            else:
+                index += 1
+        return runs
 
     # -- confirmations -----------------------------------------------------------------
     def choice(self, text: str, choices: tuple[str, ...]) -> Reading:
         """Pick one of ``choices`` by number or name; "yes" picks the only one; "no" declines."""
-        if len(text) > MAX_ANSWER_CHARS:
-            return Reading("unreadable", message=f"That answer is too long ({len(text)} characters).")
-        key = phrase(text)
-        accepted = ("Type " + " or ".join(f"{i + 1} for {c}" for i, c in enumerate(choices))
-                    + (", yes or no." if len(choices) == 1 else ", or 'no' to answer the question again."))
-        if key in self.vocabulary.yes and len(choices) == 1:
+        accepted = self.choice_forms(choices)
+        vocabulary = self.vocabulary
+        if len(text) <= MAX_ANSWER_CHARS and not refused_characters(text) and word_key(clean(text)) in vocabulary.no:
+            return Reading("reject")  # before commands: "wrong" here declines the choice
+        early, pieces = self._precheck(text, accepted)
+        if early:
+            return early
+        odd = self._odd_tokens(pieces, accepted, "choice number", len(choices))
+        if odd:
+            return odd
+        content = [t for t in pieces if not (t.kind == "word" and t.text in vocabulary.fillers)]
+        whole = " ".join(t.text for t in pieces)
+        core = " ".join(t.text for t in content)
+        if (whole in vocabulary.yes or core in vocabulary.yes) and len(choices) == 1:
             return Reading("answer", choices[0])
-        if key in self.vocabulary.no:
+        if core in vocabulary.no:
             return Reading("reject")
-        command = self.vocabulary.command(text)
-        if command in ("help", "why", "undo", "skip", "quit", "dont_know"):
-            return Reading(command)
-        numbers = self._number_words(words(clean(text)))
-        if len(numbers) == 1 and 1 <= numbers[0] <= len(choices):
-            return Reading("answer", choices[numbers[0] - 1])
-        named = self.concepts_mentioned(words(clean(text))) & set(choices)
-        if len(named) == 1:
-            return Reading("answer", named.pop())
+        if len(content) == 1:
+            number = self._number(content, 0)
+            if number is not None and 1 <= number <= len(choices):
+                return Reading("answer", choices[number - 1])
+        named, leftover = self._segment(pieces)
+        picked = set().union(*named) & set(choices) if named else set()
+        if len(picked) == 1 and not leftover and all(owners & set(choices) for owners in named):
+            return Reading("answer", picked.pop())
         return Reading("unreadable", message=f"I didn't get that. {accepted}")
+
+
+def _quoted(items) -> str:
+    """'a', 'b' and 'c' (at most five, each cut to 20 characters)."""
+    texts = [f"'{(item.text if isinstance(item, Token) else item)[:20]}'" for item in items][:5]
+    return texts[0] if len(texts) == 1 else ", ".join(texts[:-1]) + " and " + texts[-1]
+
+
+def _not_understood(shown: str, leftover: list[Token]) -> str:
+    """The refusal of a line with words left over, naming each once."""
+    names = list(dict.fromkeys(t.text for t in leftover))
+    verb = "fits" if len(names) == 1 else "fit"
+    return f"I didn't understand '{shown}' ({_quoted(names)} {verb} no accepted form)."
+
+
+def _shown_number(token: Token) -> str:
+    return token.text if len(token.text) <= 12 else token.text[:12] + "..."

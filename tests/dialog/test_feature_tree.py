@@ -62,3 +62,15 @@ def test_the_real_catalogue_builds_a_tree():
     assert sorted(node.feature for node in leaves) == list(range(len(names)))
     text = "\n".join(tree.lines())
     assert all(f"{node.number} {node.name}: {node.description}" in text for node in leaves)
+
+
+@pytest.mark.parametrize("text, fragment", [("1.1-1.9", "'1.1-1.9'"), ("%all%", "'%all%'"), ("1.1 <the>", "'<the>'"),
+                                            ("-1", "numbered 1 to 2"), ("1.1\x00", "control character"),
+                                            ("\u202e1.1", "text-direction"), ("1.1 " * 100, "too long")])
+def test_feature_answers_are_never_guessed(tree, text, fragment):
+    reading = tree.read(text)
+    assert reading.kind == "unreadable" and fragment in reading.message and "'ignore'" in reading.message
+
+
+def test_a_symbol_line_is_no_command(tree):
+    assert tree.read("%s").kind == "unreadable" and tree.read("s").kind == "skip"

@@ -120,3 +120,43 @@ def test_a_broken_vocabulary_file_is_named(tmp_path):
         load_vocabulary(path)
     with pytest.raises(VocabularyError, match="no such vocabulary file"):
         load_vocabulary(tmp_path / "missing.toml")
+
+
+@pytest.mark.parametrize("text", ["xyz frut", "fruit xyz", "it's a fruit <b>", "fruit -", "3 fruit", "(fruit)",
+                                  "snack!!!!fruit", "fruit\x00", "\x1b[31mfruit", "\u202efruit", "-1", "1.5"])
+def test_a_label_is_taken_only_when_every_word_is_consumed(parser, text):
+    reading = parser.label(text)
+    assert reading.kind == "unreadable" and reading.message.endswith(parser.label_forms())
+
+
+def test_refusals_say_what_was_wrong(parser):
+    assert "'xyz'" in parser.label("fruit xyz").message
+    assert "'<b>'" in parser.label("fruit <b>").message
+    assert "control character (U+0000)" in parser.demonstration("4\x00", 12, "fruit").message
+    assert "text-direction character" in parser.label("\u202efruit").message
+    assert "whole numbers from 1 to 12" in parser.demonstration("-1", 12, "fruit").message
+    assert "whole numbers from 1 to 4" in parser.label("2.5").message
+    assert "numbered 1 to 12" in parser.demonstration("number 99999999999999", 12, "fruit").message
+
+
+@pytest.mark.parametrize("text", ["-1", "-5", "<script>alert(1)</script>", "DROP TABLE 3; --", "number 4 xyz",
+                                  "no xyz abc", "none, 4", "4 4.5", "{4}", "4 & 5", "\ufffd3\ufffd", "1e1"])
+def test_demonstrations_are_never_guessed(parser, text):
+    reading = parser.demonstration(text, 12, "fruit")
+    assert reading.kind == "unreadable" and reading.message.endswith(parser.demonstration_forms(12, "fruit"))
+
+
+@pytest.mark.parametrize("text, kind", [("%s", "unreadable"), ("s", "skip"), ("skip!", "skip"),
+                                        ("skip <b>", "unreadable"), ("?", "help"), ("%h", "unreadable"),
+                                        ("q;", "quit"), ("-q", "unreadable")])
+def test_a_command_is_the_whole_line_in_words(parser, text, kind):
+    assert parser.label(text).kind == kind and parser.demonstration(text, 8, "fruit").kind == kind
+
+
+def test_confirmations_are_read_by_the_same_grammar(parser):
+    choices = ("fruit", "snack")
+    assert parser.choice("2", choices).value == "snack" and parser.choice("the fruit", choices).value == "fruit"
+    assert parser.choice("yes please", ("fruit",)).value == "fruit" and parser.choice("wrong", choices).kind == "reject"
+    for text in ("2 <b>", "-1", "3", "fruit xyz", "%s", "fruit and snack"):
+        reading = parser.choice(text, choices)
+        assert reading.kind == "unreadable" and reading.message.endswith(parser.choice_forms(choices))
