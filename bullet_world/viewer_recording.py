@@ -15,6 +15,7 @@ and asks the server for its static HTML, which opens with no server.
 
 from __future__ import annotations
 
+from contextlib import suppress
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -116,7 +117,12 @@ def export_html(recording: Recording, path: str | Path, camera: tuple, title: st
         window.close()
         server.stop()
     path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(html, encoding="utf-8")
+    try:
+        path.write_text(html, encoding="utf-8")
+    except OSError:  # a full disk: leave no half page behind, and let the caller name the cause
+        with suppress(OSError):
+            path.unlink(missing_ok=True)
+        raise
     return {"path": str(path), "bytes": path.stat().st_size, "seconds": round(recording.seconds, 2),
             "nodes": len(groups)}
 

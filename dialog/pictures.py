@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+from contextlib import suppress
 from pathlib import Path
 
 import cv2
 import numpy as np
+
+from dialog.output_paths import writing
 
 RING_BGR = (0, 215, 255)     # the object the robot asks about
 LABEL_BGR = (255, 255, 255)
@@ -44,9 +47,17 @@ def annotate_scene(rgb: np.ndarray, pixels, numbers, highlight: int | None = Non
 
 
 def save_picture(path: str | Path, bgr: np.ndarray) -> Path:
-    """Write a BGR image as PNG; the folder is created."""
+    """Write a BGR image as PNG; the folder is created. A write that fails raises ``OutputPathError``."""
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    if not cv2.imwrite(str(path), bgr, [cv2.IMWRITE_PNG_COMPRESSION, 3]):
-        raise RuntimeError(f"could not write the scene picture {path}")
+    encoded, png = cv2.imencode(".png", bgr, [cv2.IMWRITE_PNG_COMPRESSION, 3])
+    if not encoded:
+        raise RuntimeError(f"OpenCV could not encode the scene picture {path} as PNG")
+    with writing(path, "scene picture"):
+        path.parent.mkdir(parents=True, exist_ok=True)
+        try:
+            path.write_bytes(png.tobytes())
+        except OSError:
+            with suppress(OSError):
+                path.unlink(missing_ok=True)  # no half-written picture left behind
+            raise
     return path

@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from dialog.describe import SceneDescriber
 from dialog.feature_tree import FeatureTree
 from learning.actions import Action
+from learning.errors import OutputPathError
 
 EXPECTS = {"label": "label", "demo": "demo", "feature": "feature"}
 
@@ -143,7 +145,12 @@ class Questioner:
             self._pictured.add(scene.scene_id)
         else:
             path = Path(self.pictures) / f"scene-{scene.scene_id:03d}-turn-{number:03d}-object-{highlight + 1}.png"
-        return str(draw(scene, path, highlight))
+        try:
+            return str(draw(scene, path, highlight))
+        except OutputPathError as error:  # pictures are optional: one warning, and the session goes on without
+            print(f"warning: {error}; going on without scene pictures", file=sys.stderr, flush=True)
+            self.pictures = None
+            return None
 
     def prompt(self, scene, action: Action, explanation: str, number: int, deadline: float | None,
                pictures: bool = True) -> Prompt:

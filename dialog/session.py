@@ -7,16 +7,21 @@ replay the recorded answers into a fresh learning state before going on.
 
 from __future__ import annotations
 
+import json
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from bullet_world.datafiles import available, resolve
 from dialog.clock import VirtualClock, WallClock
 from dialog.manager import DialogManager, EpisodeConfig, episode_generators
+from dialog.records import check_turn_record
 from dialog.teachers import ReplayTeacher, ScriptedTeacher
 from dialog.terminal import TerminalTeacher
-from dialog.transcript import TranscriptWriter, read_session
+from dialog.transcript import VERSION, TranscriptWriter, read_numbered_session, read_session
 from learning.actions import DEFAULT_COSTS
-from learning.strategies import make_strategy
+from learning.errors import DataFileError, TranscriptError
+from learning.strategies import STRATEGY_NAMES, make_strategy
 
 TEACHERS = ("terminal", "scripted", "replay")
 SCRIPTED_OPTIONS = ("mislabel_rate", "dont_know_rate", "feature_quality", "answer_delay")
@@ -58,26 +63,102 @@ class SessionSettings:
 
     @classmethod
     def from_header(cls, header: dict | None, path) -> SessionSettings:
-        """Settings of a recorded session; a transcript without a usable header gets a clear message."""
+        """Settings of a recorded session; a header that is missing or malformed is refused as ``FILE: line 1: ...``."""
         if not header:
-            raise ValueError(f"{path} has no session header; only transcripts written by teachbot can be resumed")
+            raise TranscriptError(f"{path} has no session header; only transcripts written by teachbot can be resumed")
+        check_header(header, path)
         names = {f for f in cls.__dataclass_fields__}
-        values = {key: header[key] for key in names if key in header}
-        missing = sorted({"task", "kitchen", "strategy", "seed", "turns", "budget", "change_every"} - set(values))
-        if missing:
-            raise ValueError(f"{path}: the session header lacks {', '.join(missing)}")
-        return cls(**values)
+        return cls(**{key: header[key] for key in names if key in header})
+
+
+REQUIRED = ("task", "kitchen", "strategy", "seed", "turns", "budget", "change_every")
+
+
+def check_header(header: dict, path) -> None:
+    """Every field of a session header has its type and a value a session accepts."""
+    def refuse(name: str, expected: str):
+        value = json.dumps(header.get(name))[:80]
+        return TranscriptError(f"{path}: line 1: the session header's '{name}' is {value} (expected {expected})")
+
+    missing = [name for name in REQUIRED if name not in header]
+    if missing:
+        raise TranscriptError(f"{path}: line 1: the session header lacks {', '.join(missing)}")
+    if header.get("version", VERSION) != VERSION:
+        raise refuse("version", f"{VERSION}; this teachbot reads version {VERSION} transcripts")
+    if header.get("command", "teach") != "teach":
+        raise refuse("command", "'teach': only teach sessions can be resumed")
+    for name, folder in (("task", "tasks"), ("kitchen", "kitchens")):
+        if not _known_data_file(folder, header[name]):
+            raise refuse(name, f"one of {', '.join(available(folder))}")
+    if header["strategy"] not in STRATEGY_NAMES:
+        raise refuse("strategy", f"one of {', '.join(STRATEGY_NAMES)}")
+    if not (_is_int(header["seed"]) and header["seed"] >= 0):
+        raise refuse("seed", "a whole number of 0 or more")
+    for name in ("turns", "change_every"):
+        if not (_is_int(header[name]) and header[name] >= 1):
+            raise refuse(name, "a whole number of at least 1")
+    if not (_is_number(header["budget"]) and header["budget"] >= 0):
+        raise refuse("budget", "a finite number of cost units, 0 or more")
+    realtime = header.get("realtime")
+    if realtime is not None and not (_is_number(realtime) and realtime > 0):
+        raise refuse("realtime", "null or a positive number of seconds per turn")
+    if not isinstance(header.get("fetch_from_pantry", True), bool):
+        raise refuse("fetch_from_pantry", "true or false")
+    costs = header.get("costs", DEFAULT_COSTS)
+    if not (isinstance(costs, dict) and set(costs) == set(DEFAULT_COSTS)
+            and all(_is_number(v) and v >= 0 for v in costs.values())):
+        raise refuse("costs", f"a cost of 0 or more for each of {', '.join(DEFAULT_COSTS)}")
+    concepts = header.get("concepts", [])
+    if not (isinstance(concepts, list) and all(isinstance(c, str) for c in concepts)):
+        raise refuse("concepts", "a list of concept names")
+    if "features" in header and not (_is_int(header["features"]) and header["features"] >= 1):
+        raise refuse("features", "the number of features, at least 1")
+    _check_teacher(header.get("teacher", {"kind": "terminal"}), refuse)
+
+
+def _check_teacher(teacher, refuse) -> None:
+    if not isinstance(teacher, dict) or teacher.get("kind") not in TEACHERS:
+        raise refuse("teacher", f"a table whose kind is one of {', '.join(TEACHERS)}")
+    unknown = sorted(set(teacher) - {"kind", "transcript", *SCRIPTED_OPTIONS})
+    if unknown:
+        raise refuse("teacher", f"no options but kind, transcript, {', '.join(SCRIPTED_OPTIONS)}; "
+                                f"unknown: {', '.join(unknown)}")
+    for name in SCRIPTED_OPTIONS:
+        value = teacher.get(name, 0.0)
+        top = math.inf if name == "answer_delay" else 1.0
+        if not (_is_number(value) and 0 <= value <= top):
+            raise refuse("teacher", f"{name} {'zero or more seconds' if top > 1 else 'between 0 and 1'}, "
+                                    f"not {json.dumps(value)}")
+    if teacher["kind"] == "replay" and not (isinstance(teacher.get("transcript"), str) and teacher["transcript"]):
+        raise refuse("teacher", "the path of the transcript a replay teacher answers from")
+
+
+def _is_int(value) -> bool:
+    return isinstance(value, int) and not isinstance(value, bool)
+
+
+def _is_number(value) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+
+
+def _known_data_file(folder: str, name) -> bool:
+    if not isinstance(name, str) or not name:
+        return False
+    try:
+        return resolve(folder, name).is_file()
+    except DataFileError:
+        return False
 
 
 def check_compatible(header: dict, environment, path) -> None:
     """A recorded session can only go on with the same concepts and features."""
     concepts, features = header.get("concepts"), header.get("features")
     if concepts is not None and list(concepts) != list(environment.concepts):
-        raise ValueError(f"{path} was recorded with the concepts {concepts}; this task has "
-                         f"{list(environment.concepts)}")
+        raise TranscriptError(f"{path}: line 1: the session was recorded with the concepts {concepts}; this task "
+                              f"has {list(environment.concepts)}")
     if features is not None and features != len(environment.feature_names):
-        raise ValueError(f"{path} was recorded with {features} features; this kitchen gives "
-                         f"{len(environment.feature_names)} (the feature catalogue changed since)")
+        raise TranscriptError(f"{path}: line 1: the session was recorded with {features} features; this kitchen "
+                              f"gives {len(environment.feature_names)} (the feature catalogue changed since)")
 
 
 def make_clock(settings: SessionSettings, start: float = 0.0):
@@ -98,21 +179,50 @@ def make_teacher(settings: SessionSettings, rngs, clock, input_stream=None, outp
 
 def open_session(settings: SessionSettings, environment, transcript_path: str | Path, *, resume: bool = False,
                  pictures: str | None = None, input_stream=None, output_stream=None, say=None,
-                 observers=()) -> tuple[DialogManager, list[dict]]:
-    """The manager for a new session, or for a recorded one (its turns to replay come back too)."""
-    records: list[dict] = []
+                 observers=(), lock=None) -> tuple[DialogManager, list[dict]]:
+    """The manager for a new session, or for a recorded one with its turns already replayed (they come back too).
+
+    ``lock`` is the transcript's :class:`TranscriptLock` when the caller took it already (one writer per file).
+
+    Resuming checks every recorded turn, then replays it against the rebuilt
+    episode; a malformed or diverging record is refused as ``FILE: line N: ...``.
+    """
+    numbered: list[tuple[int, dict]] = []
     start = 0.0
     if resume:
-        header, records = read_session(transcript_path, tolerate_partial_tail=True)
+        header, numbered = read_numbered_session(transcript_path, tolerate_partial_tail=True)
         check_compatible(header or {}, environment, transcript_path)
-        if records:
-            start = float(records[-1].get("ended", records[-1].get("time", 0.0)))
+        for expected, (line, record) in enumerate(numbered, start=1):
+            try:
+                check_turn_record(record, expected, settings.turns, environment.concepts, environment.feature_names)
+            except TranscriptError as error:
+                raise TranscriptError(f"{transcript_path}: line {line}: {error}") from None
+        if numbered:
+            start = float(numbered[-1][1].get("ended", numbered[-1][1].get("time", 0.0)))
     rngs = episode_generators(settings.seed)
     clock = make_clock(settings, start)
     teacher = make_teacher(settings, rngs, clock, input_stream, output_stream)
-    transcript = TranscriptWriter(transcript_path, append=resume)
+    transcript = TranscriptWriter(transcript_path, append=resume, lock=lock)
     manager = DialogManager(environment, teacher, make_strategy(settings.strategy), settings.config(pictures),
                             transcript, rngs, say=say or print, observers=observers, clock=clock,
                             session=settings.header())
-    return manager, records
+    try:
+        replay(manager, numbered, transcript_path)
+    except BaseException:
+        transcript.close()
+        raise
+    return manager, [record for _, record in numbered]
 
+
+def replay(manager: DialogManager, numbered: list[tuple[int, dict]], path) -> None:
+    """Re-apply recorded turns quietly; one that diverges from the rebuilt episode names its line."""
+    manager.begin()
+    speak, manager.say = manager.say, lambda _text: None
+    try:
+        for line, record in numbered:
+            try:
+                manager.replay_turn(record)
+            except TranscriptError as error:
+                raise TranscriptError(f"{path}: line {line}: {error}") from None
+    finally:
+        manager.say = speak

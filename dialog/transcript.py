@@ -12,6 +12,10 @@ import json
 import os
 from pathlib import Path
 
+from dialog.output_paths import writing
+from dialog.transcript_lock import TranscriptLock
+from learning.errors import OutputPathError, TranscriptError
+
 FORMAT = "teachbot-transcript"
 VERSION = 1
 
@@ -19,24 +23,42 @@ VERSION = 1
 class TranscriptWriter:
     """Appends one JSON object per line; every write reaches the disk before returning.
 
+    The writer holds the transcript's lock (:class:`TranscriptLock`, taken here
+    unless one is handed in) until ``close``: one writer per transcript.
     ``append=True`` continues an existing transcript (``--resume``): a last line
     cut short by a crash is dropped first, so the file stays valid JSON Lines.
+    A write that fails (full disk, read-only) is cut back off and raises
+    :class:`OutputPathError`; every earlier line stays intact.
     """
 
-    def __init__(self, path: str | Path, append: bool = False):
+    def __init__(self, path: str | Path, append: bool = False, lock: TranscriptLock | None = None):
         self.path = Path(path)
-        self.path.parent.mkdir(parents=True, exist_ok=True)
-        if append and self.path.exists():
-            drop_partial_tail(self.path)
-            self._handle = open(self.path, "a", encoding="utf-8")
-        else:
-            self._handle = open(self.path, "w", encoding="utf-8")
-        self.has_content = self.path.stat().st_size > 0
+        self.lock = lock if lock is not None else TranscriptLock(self.path)
+        try:
+            with writing(self.path, "transcript"):
+                if append:
+                    drop_partial_tail(self.path)
+                else:
+                    os.ftruncate(self.lock.fd, 0)
+            self.has_content = self.lock.size() > 0
+        except BaseException:
+            self.lock.release()
+            raise
 
     def write(self, record: dict) -> None:
-        self._handle.write(json.dumps(record, ensure_ascii=False) + "\n")
-        self._handle.flush()
-        os.fsync(self._handle.fileno())
+        if not self.lock.held:
+            raise ValueError(f"{self.path}: the transcript is closed")
+        data = memoryview((json.dumps(record, ensure_ascii=False) + "\n").encode("utf-8"))
+        fd = self.lock.fd
+        size = os.fstat(fd).st_size
+        try:
+            with writing(self.path, "transcript"):
+                while data:
+                    data = data[os.write(fd, data):]
+                os.fsync(fd)
+        except OutputPathError:
+            _truncate_quietly(fd, size)  # no half line: the file stays valid JSON Lines
+            raise
         self.has_content = True
 
     def write_header(self, session: dict) -> None:
@@ -46,13 +68,20 @@ class TranscriptWriter:
         self.write({"session": {"format": FORMAT, "version": VERSION, **session}})
 
     def close(self) -> None:
-        self._handle.close()
+        self.lock.release()
 
     def __enter__(self) -> TranscriptWriter:
         return self
 
     def __exit__(self, *exc) -> None:
         self.close()
+
+
+def _truncate_quietly(fd: int, size: int) -> None:
+    try:
+        os.ftruncate(fd, size)
+    except OSError:
+        pass  # a crash-cut tail is dropped on resume anyway
 
 
 def drop_partial_tail(path: Path) -> int:
@@ -83,8 +112,9 @@ def drop_partial_tail(path: Path) -> int:
     return size - keep
 
 
-def read_session(path: str | Path, tolerate_partial_tail: bool = False) -> tuple[dict | None, list[dict]]:
-    """The header (None for a transcript without one) and the turn records, in order.
+def read_numbered_session(path: str | Path, tolerate_partial_tail: bool = False
+                          ) -> tuple[dict | None, list[tuple[int, dict]]]:
+    """The header (None for a transcript without one) and each turn record with its line number, in order.
 
     A line that is not JSON raises a message naming its number, except a last
     line without a newline when ``tolerate_partial_tail`` (a crash mid-write).
@@ -100,20 +130,26 @@ def read_session(path: str | Path, tolerate_partial_tail: bool = False) -> tuple
         except json.JSONDecodeError as error:
             if tolerate_partial_tail and number == len(lines) and not line.endswith("\n"):
                 break
-            raise ValueError(f"{path}: line {number} is not a JSON record ({error.msg})") from None
+            raise TranscriptError(f"{path}: line {number} is not a JSON record ({error.msg})") from None
         if not isinstance(record, dict):
-            raise ValueError(f"{path}: line {number} is not a JSON object")
+            raise TranscriptError(f"{path}: line {number} is not a JSON object")
         if "session" in record:
             if number != 1 or header is not None:
-                raise ValueError(f"{path}: line {number} is a session header; only line 1 may be one")
+                raise TranscriptError(f"{path}: line {number} is a session header; only line 1 may be one")
             header = record["session"]
             if not isinstance(header, dict) or header.get("format") != FORMAT:
-                raise ValueError(f"{path}: line 1 is not a {FORMAT} header")
+                raise TranscriptError(f"{path}: line 1 is not a {FORMAT} header")
             continue
         if "turn" not in record:
-            raise ValueError(f"{path}: line {number} has no 'turn'")
-        records.append(record)
+            raise TranscriptError(f"{path}: line {number} has no 'turn'")
+        records.append((number, record))
     return header, records
+
+
+def read_session(path: str | Path, tolerate_partial_tail: bool = False) -> tuple[dict | None, list[dict]]:
+    """The header (None for a transcript without one) and the turn records, in order."""
+    header, numbered = read_numbered_session(path, tolerate_partial_tail)
+    return header, [record for _, record in numbered]
 
 
 def read_transcript(path: str | Path) -> list[dict]:

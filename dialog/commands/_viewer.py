@@ -18,6 +18,9 @@ import sys
 from contextlib import contextmanager
 from pathlib import Path
 
+from dialog.output_paths import check_writable, from_os_error
+from learning.errors import OutputPathError
+
 
 def add_viewer_option(parser: argparse.ArgumentParser) -> None:
     """Add ``--viewer`` (live meshcat mirror) and ``--viewer-export HTML`` (the episode as one page)."""
@@ -32,7 +35,7 @@ def add_viewer_option(parser: argparse.ArgumentParser) -> None:
 def start_viewer(args: argparse.Namespace, world):
     """The viewer the options ask for, or None (nothing asked, or it could not start: one warning line)."""
     live = bool(getattr(args, "viewer", False))
-    export = getattr(args, "viewer_export", None)
+    export = checked_export(getattr(args, "viewer_export", None))
     if not live and export is None:
         return None
     try:
@@ -54,6 +57,10 @@ def stop_viewer(viewer) -> dict | None:
         return None
     try:
         written = viewer.close()
+    except OSError as error:
+        print(f"warning: {from_os_error(error, viewer.export_path, 'viewer export')}; the session itself is saved",
+              file=sys.stderr)
+        return None
     except Exception as error:  # the session's own results matter more than the picture of it
         print(f"warning: the viewer did not close cleanly ({type(error).__name__}: {error})", file=sys.stderr)
         return None
@@ -61,6 +68,26 @@ def stop_viewer(viewer) -> dict | None:
         print(f"Episode page: {written['path']} ({written['bytes'] / 1e6:.1f} MB, "
               f"{written['seconds']:.0f} s of animation)", file=sys.stderr)
     return written
+
+
+def page_path(path: Path, name: str) -> Path:
+    """``path``, or ``path/name`` when ``path`` is a folder (said on standard error)."""
+    if path.is_dir():
+        print(f"{path} is a folder: the page goes to {path / name}", file=sys.stderr)
+        return path / name
+    return path
+
+
+def checked_export(path: Path | None) -> Path | None:
+    """The ``--viewer-export`` file to write, or None: one that can't be written is a warning (it is optional)."""
+    if path is None:
+        return None
+    path = page_path(path, "episode.html")
+    try:
+        return check_writable(path, "viewer export")
+    except OutputPathError as error:
+        print(f"warning: {error}; going on without the episode page", file=sys.stderr)
+        return None
 
 
 @contextmanager

@@ -12,7 +12,9 @@ from dialog.commands._viewer import add_viewer_option, viewer_observers
 from dialog.environment import SimulatedKitchen
 from dialog.manager import DialogManager, EpisodeConfig, episode_generators
 from dialog.teachers import OracleTeacher
-from dialog.transcript import TranscriptWriter
+from dialog.transcript import FORMAT, TranscriptWriter
+from dialog.transcript_lock import TranscriptLock
+from learning.errors import TranscriptError
 from learning.strategies import STRATEGY_NAMES, make_strategy
 
 SUMMARY_KEYS = ("seed", "strategy", "turns", "budget_spent", "queries", "accuracy", "transcript", "seconds")
@@ -28,18 +30,43 @@ def register(commands) -> None:
     parser.set_defaults(handler=run)
 
 
+def refuse_foreign_transcript(path: Path, lock: TranscriptLock) -> None:
+    """A demo rewrites only its own transcripts: a teach or expert session (research data) or any other file is
+    never overwritten."""
+    if lock.size() == 0:
+        return
+    with open(path, "rb") as handle:
+        first = handle.readline(1 << 16)
+    try:
+        header = json.loads(first).get("session")
+    except (ValueError, AttributeError):
+        header = None
+    if not isinstance(header, dict) or header.get("format") != FORMAT:
+        raise TranscriptError(f"{path} holds something other than a teachbot transcript; a demo does not overwrite "
+                              "it (choose another --transcript)")
+    if header.get("command", "demo") != "demo":
+        raise TranscriptError(f"{path} holds a recorded '{header['command']}' session; a demo does not overwrite it "
+                              "(choose another --transcript)")
+
+
 def run(args: argparse.Namespace) -> int:
     config = EpisodeConfig(turns=args.turns, budget=args.budget, change_every=args.change_every, seed=args.seed)
     rngs = episode_generators(args.seed)
     transcript_path = args.transcript or Path("runs") / f"demo-{args.strategy}-seed{args.seed}.jsonl"
-    environment = SimulatedKitchen(task=args.task, kitchen=args.kitchen, seed=args.seed)
+    lock = TranscriptLock(transcript_path)  # checked and held before the kitchen is built: one writer per file
     try:
-        with viewer_observers(args, environment.world) as observers, TranscriptWriter(transcript_path) as transcript:
-            manager = DialogManager(environment, OracleTeacher(rngs["teacher"]), make_strategy(args.strategy),
-                                    config, transcript, rngs, observers=observers)
-            result = manager.run()
+        refuse_foreign_transcript(transcript_path, lock)
+        environment = SimulatedKitchen(task=args.task, kitchen=args.kitchen, seed=args.seed)
+        try:
+            with viewer_observers(args, environment.world) as observers, \
+                    TranscriptWriter(transcript_path, lock=lock) as transcript:
+                manager = DialogManager(environment, OracleTeacher(rngs["teacher"]), make_strategy(args.strategy),
+                                        config, transcript, rngs, observers=observers, session={"command": "demo"})
+                result = manager.run()
+        finally:
+            environment.close()
     finally:
-        environment.close()
+        lock.release()
     print(f"\nAccuracy on {args.task} held-out scenes: {result.accuracy:.1%} "
           f"(chance {1 / len(environment.concepts):.0%}); budget spent {result.budget_spent:g} of {args.budget:g}; "
           f"queries {result.queries}; {result.seconds:.1f} s. Transcript: {result.transcript}")

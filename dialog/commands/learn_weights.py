@@ -8,6 +8,7 @@ import sys
 from pathlib import Path
 
 from dialog.commands._arguments import positive_int
+from dialog.output_paths import check_writable, writing
 
 
 def register(commands) -> None:
@@ -40,10 +41,12 @@ def run(args: argparse.Namespace, output_stream=None) -> int:
     out = output_stream or sys.stdout
     if args.out.suffix != ".toml":
         raise ValueError(f"--out {args.out}: a weights file must end in .toml")
-    if not args.out.parent.is_dir():
+    if not args.out.parent.exists():
         raise FileNotFoundError(f"--out {args.out}: the directory {args.out.parent} does not exist")
+    check_writable(args.out, "weights file")  # before the fit, which takes a while
     learned = learn_weights(args.demos, args.iterations, args.seed, args.validation, args.policy)
-    save_weights(args.out, learned.weights, weights_comment(learned))
+    with writing(args.out, "weights file"):
+        save_weights(args.out, learned.weights, weights_comment(learned))
     result, provenance = learned.result, learned.weights.provenance
     print(f"{len(learned.train)} training episodes ({result.train_turns} turns with a choice), "
           f"{len(learned.validation)} validation ({result.validation_turns} turns); {result.iterations} iterations, "

@@ -8,8 +8,9 @@ import time
 from pathlib import Path
 
 from dialog.commands._arguments import budget, positive_int
+from dialog.output_paths import check_writable, writing
 from dialog.regress.analysis import evaluate_findings, summarise
-from dialog.regress.baseline import check_against_baseline, write_baseline
+from dialog.regress.baseline import baseline_path, check_against_baseline, write_baseline
 from dialog.regress.feature_report import feature_summaries, run_feature_suite, write_feature_report
 from dialog.regress.pools import load_pools
 from dialog.regress.recipe_report import write_recipe_report
@@ -52,7 +53,13 @@ def run(args: argparse.Namespace) -> int:
         if unknown:
             raise ValueError(f"unknown strategies {unknown}; choose from: {', '.join(STRATEGY_NAMES)}")
     out = args.results or Path("results") / suite.name
-    out.mkdir(parents=True, exist_ok=True)
+    check_writable(out, "results", folder=True)
+    with writing(out, "results", inside=True):
+        out.mkdir(parents=True, exist_ok=True)
+        return _run_suite(args, suite, out)
+
+
+def _run_suite(args: argparse.Namespace, suite, out: Path) -> int:
     started = time.perf_counter()
     if suite.kind == "feature-selection":
         rows = run_feature_suite(suite, load_pools(suite.task, suite.kitchen, 1, suite.plan_options))
@@ -88,7 +95,8 @@ def run(args: argparse.Namespace) -> int:
         ps = ", ".join(f"{c.b} p={c.p:.3g}" for c in outcome.comparisons)
         print(f"  {outcome.finding.id}: {'holds' if outcome.holds else 'does not hold'} ({ps})")
     if args.update_baseline:
-        print(f"baseline written to {write_baseline(suite, summaries)}")
+        with writing(baseline_path(suite), "baseline"):
+            print(f"baseline written to {write_baseline(suite, summaries)}")
     failures = check_against_baseline(suite, summaries) if args.check else []
     for failure in failures:
         print(f"  REGRESSION {failure}")

@@ -8,10 +8,14 @@ import sys
 from pathlib import Path
 
 from dialog.commands._arguments import add_episode_options, budget, positive_seconds
+from dialog.commands._resume import check_resume_options
 from dialog.commands._viewer import add_viewer_option, start_viewer, stop_viewer
 from dialog.environment import SimulatedKitchen
+from dialog.output_paths import check_writable
 from dialog.session import SessionSettings, open_session
 from dialog.transcript import read_session
+from dialog.transcript_lock import TranscriptLock
+from learning.errors import OutputPathError
 from learning.strategies import STRATEGY_NAMES
 
 PREFERRED_STRATEGIES = ("dt-task", "dt", "all-cd", "active")
@@ -85,22 +89,55 @@ def _settings(args) -> SessionSettings:
                            realtime=args.realtime, fetch_from_pantry=not args.no_fetch, teacher=teacher)
 
 
-def run(args: argparse.Namespace, input_stream=None, output_stream=None) -> int:
+def _claim_transcript(args) -> tuple[SessionSettings, Path, TranscriptLock]:
+    """The session's settings, its transcript and the transcript's lock, taken before anything is checked."""
     if args.resume is not None:
         if not args.resume.exists():
             raise FileNotFoundError(f"no transcript at {args.resume} to resume")
-        settings = SessionSettings.from_header(read_session(args.resume, tolerate_partial_tail=True)[0], args.resume)
-        path = args.resume
-    else:
-        settings = _settings(args)
-        path = args.transcript or _default_transcript(args)
-        if path.exists() and path.stat().st_size > 0:
-            raise ValueError(f"{path} already holds a session; continue it with --resume {path} or choose another "
-                             "--transcript")
+        lock = TranscriptLock(args.resume, create=False)
+        try:
+            header = read_session(args.resume, tolerate_partial_tail=True)[0]
+            settings = SessionSettings.from_header(header, args.resume)
+            check_resume_options(args, settings, args.resume)
+            return settings, args.resume, lock
+        except BaseException:
+            lock.release()
+            raise
+    settings = _settings(args)
+    path = args.transcript or _default_transcript(args)
+    lock = TranscriptLock(path)
+    if lock.size() > 0:
+        lock.release()
+        raise ValueError(f"{path} already holds a session; continue it with --resume {path} or choose another "
+                         "--transcript")
+    return settings, path, lock
+
+
+def _picture_folder(args, path: Path, person: bool) -> Path | None:
+    """Where scene pictures go, or None; a folder that can't be written is a warning (pictures are optional)."""
+    if args.no_pictures:
+        return None
+    folder = args.pictures or (path.parent / f"{path.stem}-pictures" if person else None)
+    if folder is not None:
+        try:
+            check_writable(folder, "scene pictures", folder=True)
+        except OutputPathError as error:
+            print(f"warning: {error}; going on without scene pictures", file=sys.stderr, flush=True)
+            return None
+    return folder
+
+
+def run(args: argparse.Namespace, input_stream=None, output_stream=None) -> int:
+    settings, path, lock = _claim_transcript(args)
+    try:
+        return _teach(args, settings, path, lock, input_stream, output_stream)
+    finally:
+        lock.release()
+
+
+def _teach(args, settings: SessionSettings, path: Path, lock: TranscriptLock, input_stream, output_stream) -> int:
     person = settings.teacher["kind"] == "terminal"
-    pictures = None
-    if not args.no_pictures:
-        pictures = args.pictures or (path.parent / f"{path.stem}-pictures" if person else None)
+    pictures = _picture_folder(args, path, person)
     out = output_stream or sys.stdout
     environment = SimulatedKitchen(task=settings.task, kitchen=settings.kitchen, seed=settings.seed,
                                    pictures=pictures is not None)
@@ -110,21 +147,27 @@ def run(args: argparse.Namespace, input_stream=None, output_stream=None) -> int:
         manager, records = open_session(settings, environment, path, resume=args.resume is not None,
                                         pictures=None if pictures is None else str(pictures),
                                         input_stream=input_stream, output_stream=out, say=None,
-                                        observers=() if viewer is None else (viewer,))
+                                        observers=() if viewer is None else (viewer,), lock=lock)
         manager.say = _narrator(manager.teacher, out, person)
         intro = (f"Teaching '{settings.task}' ({', '.join(environment.concepts)}) in {settings.kitchen}: "
                  f"{settings.turns} turns, budget {settings.budget:g}, strategy {settings.strategy}. "
                  f"Transcript: {path}")
         if records:
             intro += f" (resuming after turn {len(records)})"
+        if len(records) >= settings.turns:
+            intro = (f"{path}: the session is already finished ({len(records)} of {settings.turns} turns); "
+                     "nothing to resume")
         manager.say(intro)
-        if person:
+        if person and len(records) < settings.turns:
             manager.say("Type 'help' at any question for what you can answer; 'quit' saves and stops.")
         try:
             result = manager.run(replay=records)
         except KeyboardInterrupt:
             manager.say(f"\nInterrupted. The session is saved; continue it with: teachbot teach --resume {path}")
             return 130
+        except OutputPathError as error:
+            raise OutputPathError(f"{error}. The completed turns are saved; once that is fixed, continue with: "
+                                  f"teachbot teach --resume {path}") from None
         finally:
             manager.transcript.close()
     finally:

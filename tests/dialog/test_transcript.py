@@ -2,6 +2,7 @@
 
 import json
 
+import numpy as np
 import pytest
 
 from dialog.transcript import TranscriptWriter, drop_partial_tail, read_session, read_transcript
@@ -75,3 +76,76 @@ def test_a_session_recorded_with_other_concepts_or_features_is_refused():
                                      "change_every": 1}, "t.jsonl")
     with pytest.raises(ValueError, match="teacher 'robot' is not one of"):
         SessionSettings(teacher={"kind": "robot"})
+
+
+def test_turn_records_come_with_their_line_numbers(tmp_path):
+    from dialog.transcript import read_numbered_session
+
+    path = tmp_path / "t.jsonl"
+    path.write_text('{"session": {"format": "teachbot-transcript"}}\n\n{"turn": 1}\n{"turn": 2}\n')
+    header, numbered = read_numbered_session(path)
+    assert header == {"format": "teachbot-transcript"} and numbered == [(3, {"turn": 1}), (4, {"turn": 2})]
+
+
+def test_unreadable_lines_are_transcript_errors(tmp_path):
+    from learning.errors import TranscriptError
+
+    path = tmp_path / "t.jsonl"
+    path.write_text('{"turn": 1}\nnot json\n')
+    with pytest.raises(TranscriptError, match=r"t.jsonl: line 2 is not a JSON record"):
+        read_session(path)
+
+
+def good_record(**changes):
+    record = {"turn": 2, "time": 1.0, "scene_id": 1, "action": {"kind": "label", "object": 3},
+              "answer": {"kind": "answer", "raw": "a fruit", "parsed": "fruit", "lines": ["a fruit"], "seconds": 0.5},
+              "cost": 1.0, "budget_left": 3.0, "undid": [1],
+              "model": {"examples": {"main dish": 0, "snack": 0, "fruit": 1, "beverage": 0}, "features_in_use": 3}}
+    record.update(changes)
+    return record
+
+
+@pytest.mark.parametrize("changes, fragment", [
+    ({"turn": 3}, "'turn' is 3 (expected turn 2"),
+    ({"turn": 2.0}, "'turn' is 2.0 (expected turn 2"),
+    ({"scene_id": None}, "'scene_id' is null"),
+    ({"action": {"kind": "demo", "concept": "pasta"}}, "'action.concept' is \"pasta\""),
+    ({"action": {"kind": "none"}}, "'answer.kind' is \"answer\" (expected one of none for a none query)"),
+    ({"answer": {"kind": "absent"}}, "'answer.kind' is \"absent\""),
+    ({"answer": {"kind": "answer", "parsed": "fruit", "lines": "a fruit"}}, "'answer.lines' is \"a fruit\""),
+    ({"action": {"kind": "demo", "concept": "fruit"}, "answer": {"kind": "answer", "parsed": "2"}},
+     "'answer.parsed' is \"2\" (expected the number of the object shown, from 1)"),
+    ({"action": {"kind": "feature"}, "answer": {"kind": "answer", "parsed": []}}, "'answer.parsed' is []"),
+    ({"undid": [2]}, "'undid' is [2]"),
+    ({"budget_left": float("nan")}, "'budget_left' is NaN"),
+    ({"model": {"examples": {"main dish": 0, "snack": 0, "fruit": -1, "beverage": 0}}}, "'model.examples'"),
+    ({"model": {"examples": {"main dish": 0, "snack": 0, "fruit": 1, "beverage": 0}, "features_in_use": 0}},
+     "'model.features_in_use' is 0"),
+    ({"fetched": {"position": [0, 0, 0]}}, "'fetched.kind' is null"),
+])
+def test_a_malformed_turn_record_names_the_field_and_what_is_accepted(changes, fragment):
+    from dialog.records import check_turn_record
+    from learning.errors import TranscriptError
+    from tests.dialog.fakes import CONCEPTS
+
+    check_turn_record(good_record(), 2, 5, CONCEPTS, ("f1", "f2", "f3"))
+    with pytest.raises(TranscriptError) as caught:
+        check_turn_record(good_record(**changes), 2, 5, CONCEPTS, ("f1", "f2", "f3"))
+    assert str(caught.value).startswith(fragment)
+
+
+def test_scene_and_gesture_fingerprints():
+    from dialog.records import gesture_difference, scene_check, scene_difference
+    from tests.dialog.fakes import FakeEnvironment
+
+    scene = FakeEnvironment().next_scene(np.random.default_rng(0))
+    recorded = scene_check(scene)
+    assert recorded["objects"] == 8 and scene_difference(recorded, scene) == "" == scene_difference(None, scene)
+    other = FakeEnvironment().next_scene(np.random.default_rng(1))
+    assert scene_difference(recorded, other).startswith("feature sum ")
+    assert scene_difference({**recorded, "objects": 9}, scene) == "9 objects recorded, 8 rebuilt"
+    gesture = {"reached": True, "horizontal_error_m": 0.004}
+    assert gesture_difference(gesture, {"reached": True, "horizontal_error_m": 0.006}) == ""
+    assert gesture_difference(gesture, {"reached": False, "horizontal_error_m": 0.004}) == "reached True recorded, " \
+        "False repeated"
+    assert "horizontal_error_m" in gesture_difference(gesture, {"reached": True, "horizontal_error_m": 0.02})

@@ -1,5 +1,6 @@
 """Kill ``teachbot teach`` with SIGKILL mid-session, resume it: no answered turn is lost, the models go on."""
 
+import json
 import signal
 
 import pytest
@@ -44,3 +45,44 @@ def test_sigkill_then_resume_loses_no_answered_turn(tmp_path):
     assert records[4]["model"]["examples"]["fruit"] == 5  # the replayed answers are in the model
     assert records[-1]["model"]["examples"]["fruit"] == 8
     assert records[4]["time"] >= records[3]["ended"]  # the session clock goes on from where it stopped
+
+
+def scripted_session(path, *extra):
+    from dialog.cli import main
+
+    return main(["teach", "--teacher", "scripted", "--strategy", "active", "--turns", "5", "--budget", "10",
+                 "--change-every", "2", "--seed", "6", "--transcript", str(path), "--no-pictures", *map(str, extra)])
+
+
+def test_a_cut_scripted_session_resumes_to_the_same_bytes_and_old_transcripts_still_resume(tmp_path, capsys):
+    from dialog.cli import main
+
+    whole = tmp_path / "whole.jsonl"
+    assert scripted_session(whole) == 0
+    lines = whole.read_text().splitlines(keepends=True)
+    assert all("scene_check" in json.loads(line) for line in lines[1:])
+
+    cut = tmp_path / "cut.jsonl"
+    cut.write_text("".join(lines[:3]))
+    assert main(["teach", "--resume", str(cut), "--no-pictures"]) == 0
+    assert cut.read_bytes() == whole.read_bytes()
+
+    def old_format(line: str) -> str:  # a transcript written before records had a scene fingerprint
+        record = json.loads(line)
+        record.pop("scene_check", None)
+        return json.dumps(record, ensure_ascii=False) + "\n"
+
+    old = tmp_path / "old.jsonl"
+    old.write_text("".join(old_format(line) for line in lines[:3]))
+    capsys.readouterr()
+    assert main(["teach", "--resume", str(old), "--no-pictures", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out.strip().splitlines()[-1])["completed"] == 5
+
+    header = json.loads(lines[0])
+    header["session"]["seed"] = 7
+    other_seed = tmp_path / "other-seed.jsonl"
+    other_seed.write_text(json.dumps(header) + "\n" + "".join(old_format(line) for line in lines[1:3]))
+    assert main(["teach", "--resume", str(other_seed), "--no-pictures"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"teachbot teach: {other_seed}: line 2: turn 1: the recorded question ")
+    assert "made with another seed, task or kitchen" in err and "Traceback" not in err

@@ -1,0 +1,63 @@
+"""``teach --resume``: options given beside it must agree with the recorded session, which keeps its settings."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from learning.errors import TranscriptError
+
+# option: (attribute of the parsed arguments, the recorded session's value of it)
+SESSION_OPTIONS = {
+    "--task": ("task", lambda s: s.task),
+    "--kitchen": ("kitchen", lambda s: s.kitchen),
+    "--strategy": ("strategy", lambda s: s.strategy),
+    "--seed": ("seed", lambda s: s.seed),
+    "--turns": ("turns", lambda s: s.turns),
+    "--budget": ("budget", lambda s: s.budget),
+    "--change-every": ("change_every", lambda s: s.change_every),
+    "--realtime": ("realtime", lambda s: s.realtime),
+    "--teacher": ("teacher", lambda s: s.teacher["kind"]),
+    "--replay": ("replay", lambda s: s.teacher.get("transcript")),
+    "--mislabel-rate": ("mislabel_rate", lambda s: s.teacher.get("mislabel_rate", 0.0)),
+    "--dont-know-rate": ("dont_know_rate", lambda s: s.teacher.get("dont_know_rate", 0.0)),
+    "--feature-quality": ("feature_quality", lambda s: s.teacher.get("feature_quality", 1.0)),
+    "--answer-delay": ("answer_delay", lambda s: s.teacher.get("answer_delay", 0.0)),
+    "--no-fetch": ("no_fetch", lambda s: not s.fetch_from_pantry),
+}
+
+
+def teach_defaults() -> argparse.Namespace:
+    """What ``teachbot teach`` parses when no option is given."""
+    from dialog.cli import build_parser  # here, not at import: the command line imports this module
+
+    return build_parser().parse_args(["teach"])
+
+
+def _same(given, recorded) -> bool:
+    if isinstance(given, Path) or isinstance(recorded, Path):
+        return recorded is not None and Path(given) == Path(recorded)
+    return given == recorded
+
+
+def differing_options(args: argparse.Namespace, settings, path: Path, defaults: argparse.Namespace) -> list[str]:
+    """``--option given (recorded)`` for every option given beside --resume that the recorded session contradicts."""
+    found = []
+    for option, (name, recorded_value) in SESSION_OPTIONS.items():
+        if not hasattr(args, name):
+            continue
+        given, recorded = getattr(args, name), recorded_value(settings)
+        if given != getattr(defaults, name, None) and not _same(given, recorded):
+            found.append(f"{option} {given} (recorded: {recorded})")
+    transcript = getattr(args, "transcript", None)
+    if transcript is not None and Path(transcript).resolve() != Path(path).resolve():
+        found.append(f"--transcript {transcript} (the resumed session goes on in {path})")
+    return found
+
+
+def check_resume_options(args: argparse.Namespace, settings, path: Path) -> None:
+    """Refuse options beside --resume that differ from the recorded session, naming each of them."""
+    differing = differing_options(args, settings, path, teach_defaults())
+    if differing:
+        raise TranscriptError(f"{path}: a resumed session keeps its recorded settings, but {'; '.join(differing)} "
+                              "differ; leave them out, or start a new session without --resume")
