@@ -37,8 +37,9 @@ class LocalServer:
     def __init__(self, timeout_s: float = START_TIMEOUT_S):
         self._log = tempfile.TemporaryFile()
         env = dict(os.environ, PYTHONUNBUFFERED="1")
-        self.process = subprocess.Popen([sys.executable, "-u", str(SERVER_SCRIPT)],
-                                        stdout=subprocess.PIPE, stderr=self._log, stdin=subprocess.DEVNULL, env=env)
+        # the child follows this process: it exits when its stdin (held open here) closes or this process dies
+        self.process = subprocess.Popen([sys.executable, "-u", str(SERVER_SCRIPT), "--parent", str(os.getpid())],
+                                        stdout=subprocess.PIPE, stderr=self._log, stdin=subprocess.PIPE, env=env)
         try:
             self.zmq_url, self.web_url = self._read_addresses(timeout_s)
         except ViewerError:
@@ -75,6 +76,8 @@ class LocalServer:
 
     def stop(self) -> None:
         """Stop the child process (terminate, then kill if it lingers)."""
+        if self.process.stdin is not None:
+            self.process.stdin.close()
         if self.process.poll() is None:
             self.process.terminate()
             try:

@@ -6,13 +6,43 @@ address too. Run as a script (``python viewer_server_process.py``), it prints
 ``zmq_url=...`` and ``web_url=...`` for the parent and serves until stopped.
 It imports only tornado, ZeroMQ and meshcat's server module: meshcat's package
 ``__init__`` (numpy, IPython, PIL) is skipped, which halves the start-up time.
+
+The server ends with its parent, however the parent ends: on Linux the kernel
+sends it SIGTERM when the parent dies (``prctl(PR_SET_PDEATHSIG)``; strictly,
+when the parent's thread that started it ends), and everywhere it exits when
+its standard input, a pipe the parent holds open, reaches end of file. Ctrl-C
+in the terminal is left to the parent, which stops the server itself.
 """
 
+import ctypes
 import importlib.util
+import os
+import signal
 import sys
+import threading
 import types
 
 LOOPBACK = "127.0.0.1"
+PR_SET_PDEATHSIG = 1
+
+
+def follow_parent(parent_pid: int) -> None:
+    """End this process when the parent ``parent_pid`` ends (death signal, plus end of file on stdin)."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    if sys.platform.startswith("linux"):
+        try:
+            ctypes.CDLL(None, use_errno=True).prctl(PR_SET_PDEATHSIG, int(signal.SIGTERM), 0, 0, 0)
+        except (OSError, AttributeError):
+            pass  # the stdin watch below still ends the server
+    if os.getppid() != parent_pid:  # the parent ended before the death signal was armed
+        os._exit(0)
+    threading.Thread(target=_exit_at_end_of_input, name="parent-watch", daemon=True).start()
+
+
+def _exit_at_end_of_input() -> None:
+    while sys.stdin.buffer.read(4096):
+        pass
+    os._exit(0)
 
 
 def _server_module():
@@ -48,6 +78,8 @@ def bridge_class():
 
 
 def main() -> None:
+    if len(sys.argv) > 2 and sys.argv[1] == "--parent":
+        follow_parent(int(sys.argv[2]))
     bridge = bridge_class()(host=LOOPBACK)
     print(f"zmq_url={bridge.zmq_url}", flush=True)
     print(f"web_url={bridge.web_url}", flush=True)

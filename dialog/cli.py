@@ -11,9 +11,11 @@ from __future__ import annotations
 import argparse
 import importlib
 import pkgutil
+import signal
 import sys
 
 import dialog.commands
+from dialog.interrupts import CleanSignals, exit_code
 from dialog.threads import one_blas_thread
 
 
@@ -30,13 +32,35 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
-    args = build_parser().parse_args(argv)
-    try:
-        with one_blas_thread():
-            return int(args.handler(args) or 0)
-    except (ValueError, RuntimeError, FileNotFoundError) as error:
-        print(f"teachbot {args.command}: {error}", file=sys.stderr)
-        return 2
+    """Run one command; Ctrl-C at any moment ends it with "Interrupted." and 130, SIGTERM/SIGHUP with 128 + N.
+
+    Once a signal has arrived, whatever error reaches here is its doing (C code, an import, may turn
+    the KeyboardInterrupt into another error), so it ends the same way. Called with no ``argv`` (the
+    ``teachbot`` program), signals during the interpreter's shutdown end the process quietly too.
+    """
+    args = None
+    signals = CleanSignals(keep_after=argv is None)
+    with signals:
+        try:
+            args = build_parser().parse_args(argv)
+            with one_blas_thread():
+                return int(args.handler(args) or 0)
+        except BaseException as error:
+            command = "teachbot" if args is None else f"teachbot {args.command}"
+            if signals.signum is not None:
+                return _report_signal(command, signals.signum)
+            if isinstance(error, (ValueError, RuntimeError, FileNotFoundError)):
+                print(f"{command}: {error}", file=sys.stderr)
+                return 2
+            raise
+
+
+def _report_signal(command: str, signum: int) -> int:
+    if signum == signal.SIGINT:
+        print("\nInterrupted.", file=sys.stderr, flush=True)
+    else:
+        print(f"\n{command}: stopped by {signal.Signals(signum).name}.", file=sys.stderr, flush=True)
+    return exit_code(signum)
 
 
 if __name__ == "__main__":

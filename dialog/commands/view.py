@@ -4,7 +4,8 @@ The scene is the first one ``teachbot demo`` would show for the same task,
 kitchen and seed. ``--point N`` makes the arm point at object N the way a
 label question does (highlight, question text); ``--export`` writes the
 scene (and the pointing motion) as one static HTML page; ``--screenshot``
-saves a PNG through headless Chromium.
+saves a PNG through headless Chromium. With either of them the command writes
+its files and exits, unless ``--serve`` or ``--seconds`` asks it to keep serving.
 """
 
 from __future__ import annotations
@@ -29,15 +30,23 @@ def register(commands) -> None:
     parser.add_argument("--screenshot", type=Path, default=None, metavar="PNG",
                         help="save a picture of the page through headless Chromium (needs chromium and playwright)")
     parser.add_argument("--seconds", type=seconds, default=None,
-                        help="keep serving this long, then exit (default: until Ctrl-C; 0: exit at once)")
+                        help="keep serving this long, then exit (default: until Ctrl-C, or at once after "
+                             "--export/--screenshot; 0: exit at once)")
+    parser.add_argument("--serve", action="store_true",
+                        help="keep serving until Ctrl-C after --export/--screenshot too")
     parser.set_defaults(handler=run)
 
 
 def run(args: argparse.Namespace) -> int:
     from bullet_world.viewer import Viewer
+    from dialog.commands._viewer import page_path
     from dialog.environment import SimulatedKitchen
     from dialog.manager import episode_generators
+    from dialog.output_paths import check_writable, writing
 
+    export = None
+    if args.export is not None:
+        export = check_writable(page_path(args.export, "scene.html"), "scene page")
     environment = SimulatedKitchen(task=args.task, kitchen=args.kitchen, seed=args.seed)
     try:
         scene = environment.next_scene(episode_generators(args.seed)["scenes"])
@@ -56,20 +65,29 @@ def run(args: argparse.Namespace) -> int:
             print(f"Scene {scene.scene_id} of {args.task} in {args.kitchen} (seed {args.seed}): "
                   f"{scene.n_objects} objects, numbered 1 to {scene.n_objects}.")
             print(f"Viewer: {viewer.url}")
-            if args.export is not None:
-                written = viewer.export_html(args.export, title=f"teachbot {args.task} seed {args.seed}")
+            if export is not None:
+                with writing(export, "scene page"):
+                    written = viewer.export_html(export, title=f"teachbot {args.task} seed {args.seed}")
                 print(f"Page: {written['path']} ({written['bytes'] / 1e6:.1f} MB)")
             if args.screenshot is not None:
                 from bullet_world.viewer_snapshot import screenshot
 
                 shot = screenshot(viewer.url, args.screenshot, min_drawn=scene.n_objects + 2)
                 print(f"Picture: {shot['path']} ({shot['drawn']} meshes and labels drawn)")
-            _serve(args.seconds)
+            _serve(_serving_seconds(args))
         finally:
             viewer.close()
     finally:
         environment.close()
     return 0
+
+
+def _serving_seconds(args: argparse.Namespace) -> float | None:
+    """How long to serve: --seconds if given; else until Ctrl-C, except after writing a page or picture."""
+    if args.seconds is not None:
+        return args.seconds
+    wrote_files = args.export is not None or args.screenshot is not None
+    return 0.0 if wrote_files and not args.serve else None
 
 
 def _serve(duration: float | None) -> None:

@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import os
+import signal
 import sys
+import threading
 from collections.abc import Callable
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
@@ -53,8 +55,12 @@ def run_on_ray(specs: list[EpisodeSpec], address: str, progress: bool = True) ->
         import ray
     except ImportError:
         raise RuntimeError("--ray needs the optional extra: pip install 'teachbot[ray]'") from None
-    ray.init(address=None if address == "local" else address, include_dashboard=False,
-             ignore_reinit_error=True, log_to_driver=False)
+    if address == "local":
+        start_local_ray(ray)
+    else:
+        print(f"teachbot regress: --ray {address}: this code runs on that cluster and its results are unpickled "
+              "here; name only a cluster you trust", file=sys.stderr)
+        ray.init(address=address, ignore_reinit_error=True, log_to_driver=False)
     remote_episode = ray.remote(run_episode)
     pending = {remote_episode.remote(spec): i for i, spec in enumerate(specs)}
     results: list[dict | None] = [None] * len(specs)
@@ -65,6 +71,60 @@ def run_on_ray(specs: list[EpisodeSpec], address: str, progress: bool = True) ->
             results[index] = ray.get(done[0])
             advance(specs[index].label)
     return results
+
+
+LOCAL_RAY_ENVIRONMENT = {
+    "RAY_AUTH_MODE": "token",  # every Ray RPC carries the cluster's token (Ray writes it to ~/.ray/auth_token)
+    "RAY_ENABLE_WINDOWS_OR_OSX_CLUSTER": "0",  # a one-node instance: Ray binds its servers to 127.0.0.1
+}
+
+
+def start_local_ray(ray) -> None:
+    """Start a one-node Ray instance here, bound to 127.0.0.1, with token authentication, no dashboard.
+
+    Ray picks the loopback address when clusters are turned off (``RAY_ENABLE_WINDOWS_OR_OSX_CLUSTER=0``,
+    read at import and by the processes it starts). Token mode stays set: this process talks to the
+    instance with it. ``ray.init`` replaces the SIGTERM handler; it is put back so SIGTERM still ends
+    ``teachbot`` cleanly.
+    """
+    if ray.is_initialized():
+        return
+    mode = os.environ.get("RAY_AUTH_MODE", "token")
+    if mode.lower() != "token":
+        print(f"teachbot regress: RAY_AUTH_MODE={mode} ignored: --ray local always uses token authentication",
+              file=sys.stderr)
+    constants = ray._private.ray_constants
+    saved_variable = os.environ.get("RAY_ENABLE_WINDOWS_OR_OSX_CLUSTER")
+    saved_flag, saved_sigterm = constants.ENABLE_RAY_CLUSTER, signal.getsignal(signal.SIGTERM)
+    os.environ.update(LOCAL_RAY_ENVIRONMENT)
+    constants.ENABLE_RAY_CLUSTER = False  # in case ray was imported before the variable was set
+    try:
+        _reload_ray_settings(ray)
+        ray.init(include_dashboard=False, log_to_driver=False)
+        _check_token_mode(ray)
+    finally:
+        constants.ENABLE_RAY_CLUSTER = saved_flag
+        if saved_variable is None:
+            del os.environ["RAY_ENABLE_WINDOWS_OR_OSX_CLUSTER"]
+        else:
+            os.environ["RAY_ENABLE_WINDOWS_OR_OSX_CLUSTER"] = saved_variable
+        if saved_sigterm is not None and threading.current_thread() is threading.main_thread():
+            signal.signal(signal.SIGTERM, saved_sigterm)
+
+
+def _reload_ray_settings(ray) -> None:
+    """Make Ray's cached settings (read when ``ray`` was imported) see RAY_AUTH_MODE, as Ray does itself."""
+    config = getattr(getattr(ray, "_raylet", None), "Config", None)
+    if config is not None:
+        config.initialize("")
+
+
+def _check_token_mode(ray) -> None:
+    mode = getattr(getattr(ray, "_raylet", None), "get_authentication_mode", None)
+    if mode is None or mode() != ray._raylet.AuthenticationMode.TOKEN:
+        ray.shutdown()
+        raise RuntimeError(f"--ray local needs token authentication, which Ray {ray.__version__} does not offer "
+                           "(it came in Ray 2.52): pip install 'ray>=2.52'")
 
 
 class _progress:
