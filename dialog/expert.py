@@ -3,7 +3,7 @@
 The one loop stays ``DialogManager``: ``ExpertStrategy`` is an ordinary
 strategy whose ``choose`` computes every candidate action and its expected
 decision features exactly as the DT strategy does at run time
-(``learning.decision.expected_decision_features`` with the same what-if engine
+(``learning.decision.candidates.expected_decision_features`` with the same what-if engine
 and window), hands them to a *chooser* (``dialog.expert_terminal.PersonChooser``
 or ``dialog.scripted_expert.ScriptedExpertChooser``), and records the turn as
 an IRL ``DecisionTurn`` (Phi of every candidate, the chosen row). A scripted
@@ -29,9 +29,9 @@ from dialog.manager import DialogManager, EpisodeConfig, EpisodeResult, episode_
 from dialog.teachers import ScriptedTeacher
 from dialog.transcript import TranscriptWriter
 from learning.actions import DEFAULT_COSTS, Action, Decision
-from learning.decision import CandidateFeatures, expected_decision_features
-from learning.decision_features import FEATURE_NAMES
-from learning.irl_data import DecisionTurn, QuestioningEpisode, save_episodes
+from learning.decision.candidates import CandidateFeatures, expected_decision_features
+from learning.decision.features import FEATURE_NAMES
+from learning.irl.demonstrations import DecisionTurn, QuestioningEpisode, save_episodes
 from learning.state import LearningState
 from learning.strategies.base import Strategy
 from learning.whatif import make_engine

@@ -16,7 +16,7 @@ from dialog.describe import SceneDescriber
 from dialog.expert import ExpertQuit, ExpertView, action_label
 from dialog.terminal import LineReader
 from learning.actions import Action, DemoQuery, FeatureQuery, LabelQuery, NoQuery
-from learning.decision_features import label_distribution
+from learning.decision.features import label_distribution
 
 SHORT_NAMES = ("ACD", "CDU", "IV", "PM", "budget", "time", "quiet")  # FEATURE_NAMES order
 HELP = ("Type one of: LQ <object number> (or just the number), DQ <concept name or number>, FSQ, none, "

@@ -41,7 +41,7 @@ import numpy as np
 from dialog.expert import ExpertView
 from learning.actions import Action, DemoQuery, FeatureQuery, NoQuery
 from learning.datafiles import check_keys, integer, number, read_toml, section
-from learning.decision_features import label_distribution
+from learning.decision.features import label_distribution
 
 RULES_FILE = Path(__file__).parent / "data" / "scripted-expert.toml"
 

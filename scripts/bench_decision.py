@@ -57,8 +57,8 @@ import time  # noqa: E402
 
 import numpy as np  # noqa: E402
 
-from learning.decision import expected_decision_features  # noqa: E402
-from learning.decision_weights import resolve_weights  # noqa: E402
+from learning.decision.candidates import expected_decision_features  # noqa: E402
+from learning.decision.weights import resolve_weights  # noqa: E402
 from learning.strategies.decision_theoretic import choose_index  # noqa: E402
 from learning.synthetic import SyntheticTask, random_state  # noqa: E402
 

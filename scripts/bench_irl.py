@@ -20,7 +20,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from learning.irl_learn import learn_weights, load_demonstrations  # noqa: E402
+from learning.irl.learn import learn_weights, load_demonstrations  # noqa: E402
 
 TEACHBOT = str(Path(sys.executable).with_name("teachbot"))
 

@@ -33,8 +33,8 @@ import pybullet as p
 
 from bullet_world.catalogue import load_kitchen, load_object_kinds
 from bullet_world.perception import measure_objects
-from bullet_world.recipe_layout import Placer, object_radius_and_height
-from bullet_world.recipe_setup import load_recipe_setup
+from bullet_world.recipes.layout import Placer, object_radius_and_height
+from bullet_world.recipes.setup import load_recipe_setup
 from bullet_world.world import World
 from robot import Arm
 from robot.grasping import GRASP_MODES, GraspTarget, Obstacle

@@ -25,8 +25,8 @@ import tempfile
 import time
 from pathlib import Path
 
-from bullet_world.viewer import Viewer
-from bullet_world.viewer_snapshot import CHROMIUM_FLAGS, COUNT_DRAWN_JS, find_chromium
+from bullet_world.viewer.mirror import Viewer
+from bullet_world.viewer.snapshot import CHROMIUM_FLAGS, COUNT_DRAWN_JS, find_chromium
 from dialog.environment import SimulatedKitchen
 from dialog.manager import DialogManager, EpisodeConfig, episode_generators
 from dialog.teachers import OracleTeacher

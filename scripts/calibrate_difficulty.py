@@ -38,7 +38,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from bullet_world.catalogue import load_task  # noqa: E402
 from bullet_world.datasets import load_datasets  # noqa: E402
-from learning.feature_selection import select_features  # noqa: E402
+from learning.features.selection import select_features  # noqa: E402
 
 FEATURE_SETS = ("all", "informative", "ER", "irrelevant")
 

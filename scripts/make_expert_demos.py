@@ -1,4 +1,4 @@
-"""Make the shipped expert demonstrations (learning/weights/expert-demos/) with the scripted expert.
+"""Make the shipped expert demonstrations (learning/irl/expert-demos/) with the scripted expert.
 
 The thesis's training condition (§7.4.1): prepare-lunch, budget 15, 30 turns, a scene change every 10 turns,
 costs DQ 2, FSQ 2, LQ 1, NQ 0; one episode per seed (default seeds 1-5: `teachbot learn-weights` trains on
@@ -23,7 +23,7 @@ sys.path.insert(0, str(ROOT))
 
 from dialog.expert import ExpertSettings, run_expert_episode  # noqa: E402
 from dialog.scripted_expert import ScriptedExpertChooser  # noqa: E402
-from learning.irl_learn import SHIPPED_DEMOS  # noqa: E402
+from learning.irl.learn import SHIPPED_DEMOS  # noqa: E402
 
 
 def main() -> int:

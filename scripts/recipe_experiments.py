@@ -14,7 +14,7 @@ tested on the demonstrations of the test kitchen that were not used to train.
 
 Writes plots to ``--out`` (docs/img by default), prints Markdown tables, and
 with ``--json`` ends with one JSON line of all numbers. One ``--seed`` drives
-every random choice. The experiments live in ``dialog/regress/recipe_study.py``
+every random choice. The experiments live in ``dialog/experiments/recipes/study.py``
 (also run, in parallel and with significance tests, by ``teachbot regress
 --suite recipes``).
 
@@ -33,9 +33,9 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from bullet_world.catalogue import load_kitchen
-from dialog.regress.recipe_figures import markdown_cv, markdown_transfer, plot_cross_validation, plot_transfer
-from dialog.regress.recipe_study import collect, cross_validation, transfer, varied_pairs
-from learning.recipe import load_builtin_recipe, recipe_parameters
+from dialog.experiments.recipes.figures import markdown_cv, markdown_transfer, plot_cross_validation, plot_transfer
+from dialog.experiments.recipes.study import collect, cross_validation, transfer, varied_pairs
+from learning.recipes.format import load_builtin_recipe, recipe_parameters
 
 DEFAULT_KITCHENS = ("kitchen-1", "kitchen-2", "kitchen-3")
 

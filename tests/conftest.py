@@ -8,7 +8,7 @@ import pytest
 
 def pytest_sessionstart(session):
     """CI sets TEACHBOT_REQUIRE_BROWSER so that the headless-Chromium tests run rather than skip."""
-    from bullet_world.viewer_snapshot import find_chromium
+    from bullet_world.viewer.snapshot import find_chromium
 
     if os.environ.get("TEACHBOT_REQUIRE_BROWSER") and find_chromium() is None:
         raise pytest.UsageError("TEACHBOT_REQUIRE_BROWSER is set but no Chromium is installed at /usr/bin/chromium; "

@@ -14,14 +14,14 @@ from bullet_world.datafiles import available
 from bullet_world.features import load_feature_catalogue
 from dialog.cli import main
 from dialog.describe import COLOURS_FILE, colour_table
-from dialog.regress.suite import SUITE_DIR, SuiteError, load_suite, suite_names
+from dialog.experiments.suite import SUITE_DIR, SuiteError, load_suite, suite_names
 from dialog.scripted_expert import RULES_FILE, ExpertRules
 from dialog.vocabulary import VOCABULARY_FILE, VocabularyError, load_vocabulary
 from learning.datafiles import check_keys, numbers, read_toml, value_range
-from learning.decision_weights import PRESETS, preset_weights
+from learning.decision.weights import PRESETS, preset_weights
+from learning.decision.weights_file import load_weights
 from learning.errors import DataFileError
-from learning.irl_weights import load_weights
-from learning.recipe import builtin_recipe_names, load_builtin_recipe, load_recipe
+from learning.recipes.format import builtin_recipe_names, load_builtin_recipe, load_recipe
 
 KITCHEN = (DATA_DIR / "kitchens" / "kitchen-1.toml").read_text()
 TASK = (DATA_DIR / "tasks" / "pack-lunchbox.toml").read_text()
@@ -224,7 +224,7 @@ def test_a_binary_or_non_utf8_suite_gets_one_line(tmp_path, capsys):
 
 
 def test_a_recipe_task_refuses_a_non_finite_scene_setting(tmp_path):
-    from bullet_world.recipe_setup import load_recipe_setup
+    from bullet_world.recipes.setup import load_recipe_setup
 
     text = changed((DATA_DIR / "tasks" / "serve-pasta.toml").read_text(), "region_margin = 0.015",
                    "region_margin = nan")

@@ -39,7 +39,7 @@ def start_viewer(args: argparse.Namespace, world):
     if not live and export is None:
         return None
     try:
-        from bullet_world.viewer import Viewer
+        from bullet_world.viewer.mirror import Viewer
 
         viewer = Viewer(world, live=live, export_path=export)
     except Exception as error:  # any failure to start leaves the session headless

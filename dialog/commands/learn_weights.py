@@ -19,7 +19,7 @@ def register(commands) -> None:
                     "iterate with the best validation agreement is kept.")
     parser.add_argument("--demos", required=True, metavar="DIR_OR_shipped",
                         help="a directory of .json/.npz demonstrations (teachbot expert --out), one such file, or "
-                             "'shipped' (learning/weights/expert-demos)")
+                             "'shipped' (learning/irl/expert-demos)")
     parser.add_argument("--out", type=Path, required=True, metavar="FILE.toml", help="the weights file to write")
     parser.add_argument("--iterations", type=positive_int, default=100,
                         help="at most this many optimiser iterations (default 100, thesis §7.4.1)")
@@ -35,8 +35,8 @@ def register(commands) -> None:
 
 
 def run(args: argparse.Namespace, output_stream=None) -> int:
-    from learning.irl_learn import learn_weights, weights_comment
-    from learning.irl_weights import save_weights
+    from learning.decision.weights_file import save_weights
+    from learning.irl.learn import learn_weights, weights_comment
 
     out = output_stream or sys.stdout
     if args.out.suffix != ".toml":

@@ -22,7 +22,8 @@ import time
 import numpy as np
 
 from dialog.commands._arguments import positive_int
-from dialog.commands._recipe_session import (
+from dialog.commands._viewer import add_viewer_option, start_viewer, stop_viewer
+from dialog.recipe_session import (
     NarratedRecipeWorld,
     StepOutcome,
     execute_recipe,
@@ -30,9 +31,8 @@ from dialog.commands._recipe_session import (
     parameter_names,
     recipe_steps,
 )
-from dialog.commands._viewer import add_viewer_option, start_viewer, stop_viewer
-from learning.demonstration import DEFAULT_TAU, RecipeGrounding
-from learning.recipe import Recipe, builtin_recipe_names, load_builtin_recipe, load_recipe
+from learning.recipes.format import Recipe, builtin_recipe_names, load_builtin_recipe, load_recipe
+from learning.recipes.grounding import DEFAULT_TAU, RecipeGrounding
 from robot import Arm
 from robot.grasping import GRASP_MODES
 from robot.pick_place import Manipulator

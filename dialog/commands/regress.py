@@ -8,22 +8,22 @@ import time
 from pathlib import Path
 
 from dialog.commands._arguments import budget, positive_int
-from dialog.output_paths import check_writable, writing
-from dialog.regress.analysis import evaluate_findings, summarise
-from dialog.regress.baseline import baseline_path, check_against_baseline, write_baseline
-from dialog.regress.feature_report import feature_summaries, run_feature_suite, write_feature_report
-from dialog.regress.pools import load_pools
-from dialog.regress.recipe_report import write_recipe_report
-from dialog.regress.recipe_suite import (
+from dialog.experiments.analysis import evaluate_findings, summarise
+from dialog.experiments.baseline import baseline_path, check_against_baseline, write_baseline
+from dialog.experiments.features.report import feature_summaries, run_feature_suite, write_feature_report
+from dialog.experiments.pools import load_pools
+from dialog.experiments.recipes.report import write_recipe_report
+from dialog.experiments.recipes.suite import (
     evaluate_recipe_findings,
     load_study,
     run_recipe_suite,
     summarise_study,
     trial_count,
 )
-from dialog.regress.report import markdown_report, plot_learning_curves, plot_question_timing, write_episode_csvs
-from dialog.regress.runner import episode_specs, run_locally, run_on_ray
-from dialog.regress.suite import load_suite, suite_names
+from dialog.experiments.report import markdown_report, plot_learning_curves, plot_question_timing, write_episode_csvs
+from dialog.experiments.runner import episode_specs, run_locally, run_on_ray
+from dialog.experiments.suite import load_suite, suite_names
+from dialog.output_paths import check_writable, writing
 from learning.strategies import STRATEGY_NAMES
 
 

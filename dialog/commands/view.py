@@ -38,7 +38,7 @@ def register(commands) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from bullet_world.viewer import Viewer
+    from bullet_world.viewer.mirror import Viewer
     from dialog.commands._viewer import page_path
     from dialog.environment import SimulatedKitchen
     from dialog.manager import episode_generators
@@ -70,7 +70,7 @@ def run(args: argparse.Namespace) -> int:
                     written = viewer.export_html(export, title=f"teachbot {args.task} seed {args.seed}")
                 print(f"Page: {written['path']} ({written['bytes'] / 1e6:.1f} MB)")
             if args.screenshot is not None:
-                from bullet_world.viewer_snapshot import screenshot
+                from bullet_world.viewer.snapshot import screenshot
 
                 shot = screenshot(viewer.url, args.screenshot, min_drawn=scene.n_objects + 2)
                 print(f"Picture: {shot['path']} ({shot['drawn']} meshes and labels drawn)")

@@ -9,7 +9,7 @@ random     R: any affordable query at random
 hfs-passive HFS+P: the feature query first, then P
 hfs-active HFS+A: the feature query first, then A
 all-cd     All/CD: feature query, a few demos keeping classes uniform, then A
-dt         DT with the weights in learning/weights/dt.toml (or ``weights=``)
+dt         DT with the weights in learning/decision/presets/dt.toml (or ``weights=``)
 dt-iros    DT on ACD and CDU (thesis ch. 6)
 dt-task    DT on ACD, CDU, IV and PM (thesis ch. 7)
 dt-task-env DT on all seven decision features (thesis ch. 7; IRL weights)

@@ -1,12 +1,12 @@
 """Decision-theoretic arbitration DT (thesis §6.4.2 eq. 6.2-6.3, §7.3.1 eq. 7.1-7.2).
 
 For every affordable candidate the what-if engine simulates every answer and
-``learning.decision`` turns the simulated next states into E[phi(s') | a].
+``learning.decision.candidates`` turns the simulated next states into E[phi(s') | a].
 With weights w the expected utility is EU(a) = w . E[phi(s') | a]; the learner
 takes the best query a* only if EU(a*) > U(s), else it asks nothing this turn.
 Ties between queries go to the first in candidate order (demos, labels, FSQ).
 
-Named presets read their weights from learning/weights/<name>.toml:
+Named presets read their weights from learning/decision/presets/<name>.toml:
 ``dt`` (custom: edit the file or pass ``weights=``), ``dt-iros`` (ACD, CDU),
 ``dt-task`` (+ IV, PM) and ``dt-task-env`` (+ budget, time, non-query time;
 its file is where IRL's learned weights go).
@@ -18,8 +18,8 @@ import numpy as np
 
 from learning.actions import Action, Decision
 from learning.concepts import normalise_rows
-from learning.decision import CandidateFeatures, expected_decision_features
-from learning.decision_weights import resolve_weights
+from learning.decision.candidates import CandidateFeatures, expected_decision_features
+from learning.decision.weights import resolve_weights
 from learning.state import LearningState
 from learning.strategies.base import Strategy
 from learning.whatif import make_engine

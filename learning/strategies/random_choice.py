@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from learning.actions import Decision
-from learning.decision import candidate_actions
+from learning.decision.candidates import candidate_actions
 from learning.state import LearningState
 from learning.strategies.base import Strategy
 

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from learning.feature_selection import computational_subsets
+from learning.features.selection import computational_subsets
 
 FEATURE_SELECTION_METHOD = "ES"  # the thesis's F_{y,c}: CFS-merit forward selection (§5.3.1)
 # The DT's guess of the teacher's answer needs a subset after a handful of examples; chapter 5's chance test

@@ -3,10 +3,10 @@
 import numpy as np
 import pytest
 
-from bullet_world.recipe_setup import ELSEWHERE, load_recipe_setup
-from bullet_world.recipe_tracking import match_rows
-from bullet_world.recipe_world import RecipeWorld
-from learning.demonstration import Snapshot, parse_action
+from bullet_world.recipes.setup import ELSEWHERE, load_recipe_setup
+from bullet_world.recipes.tracking import match_rows
+from bullet_world.recipes.world import RecipeWorld
+from learning.recipes.grounding import Snapshot, parse_action
 
 SALAD = [("bowl", "cupboard", "counter"), ("salad-dressing", "fridge", "counter")]
 

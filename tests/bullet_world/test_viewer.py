@@ -14,13 +14,13 @@ import pybullet_data
 import pytest
 import umsgpack
 
-from bullet_world.viewer import Viewer
-from bullet_world.viewer_meshcat import MeshcatScene, object_jsons
-from bullet_world.viewer_meshes import MeshFileError, parse_obj
-from bullet_world.viewer_recording import Recording
-from bullet_world.viewer_scene import Look, WorldReader, pose_matrix, translation
-from bullet_world.viewer_server import LocalServer
-from bullet_world.viewer_tap import add_step_listener, is_tapped, remove_step_listener
+from bullet_world.viewer.meshcat_objects import MeshcatScene, object_jsons
+from bullet_world.viewer.meshes import MeshFileError, parse_obj
+from bullet_world.viewer.mirror import Viewer
+from bullet_world.viewer.recording import Recording
+from bullet_world.viewer.scene import Look, WorldReader, pose_matrix, translation
+from bullet_world.viewer.server import LocalServer
+from bullet_world.viewer.tap import add_step_listener, is_tapped, remove_step_listener
 
 RED, GREEN, MAGENTA = (0.9, 0.05, 0.05, 1.0), (0.05, 0.75, 0.1, 1.0), (0.85, 0.05, 0.85, 1.0)
 

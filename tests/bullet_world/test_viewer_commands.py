@@ -7,8 +7,8 @@ from pathlib import Path
 
 import pytest
 
-from bullet_world import viewer_thread
-from bullet_world.viewer_server import ViewerError
+from bullet_world.viewer import thread as viewer_thread
+from bullet_world.viewer.server import ViewerError
 from dialog.commands._viewer import add_viewer_option, start_viewer, stop_viewer, viewer_observers
 from tests.bullet_world.test_viewer import BareWorld
 

@@ -9,8 +9,8 @@ import pytest
 from dialog.expert import ExpertQuit, ExpertSettings, ExpertStrategy, run_expert_episode
 from dialog.scripted_expert import ScriptedExpertChooser, paced_budget
 from learning.actions import DEFAULT_COSTS
-from learning.decision import expected_decision_features
-from learning.irl_data import load_episodes
+from learning.decision.candidates import expected_decision_features
+from learning.irl.demonstrations import load_episodes
 from tests.dialog.fakes import FakeEnvironment
 
 TRAINING = dict(budget=15.0, turns=30, change_every=10)  # thesis §7.4.1

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from dialog.regress import runner
+from dialog.experiments import runner
 
 
 class FakeRay:

@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 
 from dialog.cli import main
-from dialog.regress import baseline
-from dialog.regress.recipe_suite import evaluate_recipe_findings, load_study, summarise_study
-from dialog.regress.suite import SuiteError, load_suite
+from dialog.experiments import baseline
+from dialog.experiments.recipes.suite import evaluate_recipe_findings, load_study, summarise_study
+from dialog.experiments.suite import SuiteError, load_suite
 
 TINY = """
 name = "tiny-recipes"

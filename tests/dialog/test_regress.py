@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 from dialog.cli import main
-from dialog.regress.analysis import checkpoint_values, evaluate_findings, summarise
-from dialog.regress.baseline import check_against_baseline, write_baseline
-from dialog.regress.suite import SuiteError, load_suite
+from dialog.experiments.analysis import checkpoint_values, evaluate_findings, summarise
+from dialog.experiments.baseline import check_against_baseline, write_baseline
+from dialog.experiments.suite import SuiteError, load_suite
 
 SUITE = """
 name = "tiny"
@@ -120,7 +120,7 @@ def test_the_same_suite_runs_on_a_local_ray_instance(tmp_path, capsys):
 
 
 def test_scripted_feature_answers_follow_the_user_model():
-    from dialog.regress.feature_study import UserModel, hfr_answer, hfs_answer
+    from dialog.experiments.features.study import UserModel, hfr_answer, hfs_answer
 
     names = ("colour.red", "size.height", "location.x", "arm.joint1", "weight")
     relevant = {"colour.red", "size.height", "weight"}
@@ -134,7 +134,7 @@ def test_scripted_feature_answers_follow_the_user_model():
 
 
 def test_stratified_samples_are_balanced_and_disjoint():
-    from dialog.regress.feature_study import srs
+    from dialog.experiments.features.study import srs
 
     concepts = np.array(["a", "b"] * 20, dtype=object)
     rng = np.random.default_rng(1)

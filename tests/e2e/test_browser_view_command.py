@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from bullet_world.viewer_snapshot import find_chromium
+from bullet_world.viewer.snapshot import find_chromium
 
 pytestmark = [
     pytest.mark.e2e, pytest.mark.browser,

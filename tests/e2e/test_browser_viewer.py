@@ -11,7 +11,7 @@ import numpy as np
 import pybullet as p
 import pytest
 
-from bullet_world.viewer_snapshot import find_chromium
+from bullet_world.viewer.snapshot import find_chromium
 
 pytestmark = [
     pytest.mark.e2e, pytest.mark.browser,
@@ -20,8 +20,8 @@ pytestmark = [
 ]
 pytest.importorskip("playwright.sync_api", reason="needs playwright (pip install playwright; the browser is chromium)")
 
-from bullet_world.viewer import Viewer  # noqa: E402
-from bullet_world.viewer_snapshot import screenshot  # noqa: E402
+from bullet_world.viewer.mirror import Viewer  # noqa: E402
+from bullet_world.viewer.snapshot import screenshot  # noqa: E402
 from tests.bullet_world.test_viewer import BareWorld  # noqa: E402
 
 WIDTH, HEIGHT, FOV_DEGREES = 1000, 700, 75.0  # meshcat's default camera has a 75 degree vertical field of view

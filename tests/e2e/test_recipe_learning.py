@@ -4,15 +4,15 @@ import numpy as np
 import pytest
 from threadpoolctl import threadpool_limits
 
-from bullet_world.recipe_world import RecipeWorld
-from dialog.commands._recipe_session import (
+from bullet_world.recipes.world import RecipeWorld
+from dialog.recipe_session import (
     action_observations,
     evaluate_demonstration,
     ground,
     parameter_names,
     recipe_steps,
 )
-from learning.recipe import load_builtin_recipe
+from learning.recipes.format import load_builtin_recipe
 
 pytestmark = pytest.mark.e2e
 

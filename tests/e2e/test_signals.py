@@ -18,7 +18,7 @@ import pytest
 pytestmark = pytest.mark.e2e
 
 TEACHBOT = str(Path(sys.executable).with_name("teachbot"))
-SERVER_SCRIPT = "viewer_server_process.py"
+SERVER_SCRIPT = "server_process.py"
 
 
 def start(*args, cwd: Path) -> subprocess.Popen:
@@ -179,7 +179,7 @@ def test_view_export_writes_the_page_and_exits(tmp_path):
 
 
 def test_the_viewer_server_ignores_ctrl_c_and_exits_when_its_input_pipe_closes():
-    from bullet_world.viewer_server import SERVER_SCRIPT as script
+    from bullet_world.viewer.server import SERVER_SCRIPT as script
 
     server = subprocess.Popen([sys.executable, str(script), "--parent", str(os.getpid())], stdin=subprocess.PIPE,
                               stdout=subprocess.PIPE, stderr=subprocess.PIPE)

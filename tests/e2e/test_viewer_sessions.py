@@ -8,8 +8,8 @@ from pathlib import Path
 
 import pytest
 
-from bullet_world import viewer_thread
-from bullet_world.viewer_server import ViewerError
+from bullet_world.viewer import thread as viewer_thread
+from bullet_world.viewer.server import ViewerError
 from dialog.cli import main
 from dialog.commands import _viewer
 
@@ -124,7 +124,7 @@ def test_placed_objects_carry_their_texture_file_and_the_viewer_draws_it_with_th
     import pybullet as p
 
     from bullet_world import World
-    from bullet_world.viewer_scene import WorldReader
+    from bullet_world.viewer.scene import WorldReader
 
     world = World(seed=1)
     try:

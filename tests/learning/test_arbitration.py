@@ -8,9 +8,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from learning.actions import DemoQuery, FeatureQuery, NoQuery
-from learning.decision import expected_decision_features
-from learning.decision_features import FEATURE_NAMES
-from learning.decision_weights import PRESETS, load_weight_file, preset_weights, resolve_weights
+from learning.decision.candidates import expected_decision_features
+from learning.decision.features import FEATURE_NAMES
+from learning.decision.weights import PRESETS, load_weight_file, preset_weights, resolve_weights
 from learning.strategies import STRATEGY_NAMES, DecisionTheoreticStrategy, make_strategy
 from learning.strategies.decision_theoretic import choose_index
 from learning.synthetic import SyntheticTask, random_state, run_episode

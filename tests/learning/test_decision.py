@@ -6,8 +6,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from learning.actions import DemoQuery, FeatureQuery, LabelQuery, NoQuery
-from learning.decision import candidate_actions, expected_decision_features
-from learning.decision_features import FEATURE_NAMES, state_features
+from learning.decision.candidates import candidate_actions, expected_decision_features
+from learning.decision.features import FEATURE_NAMES, state_features
 from learning.synthetic import SyntheticTask, random_state
 
 TASK = SyntheticTask(n_features=6, n_informative=2, seed=5)

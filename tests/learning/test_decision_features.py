@@ -7,7 +7,7 @@ from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
 from learning.actions import DemoQuery, NoQuery
-from learning.decision_features import (
+from learning.decision.features import (
     FEATURE_NAMES,
     Clock,
     class_uniformity,

@@ -3,7 +3,8 @@
 import numpy as np
 import pytest
 
-from learning.demonstration import (
+from learning.recipes.format import RecipeStep, load_builtin_recipe
+from learning.recipes.grounding import (
     MATCH,
     NO_LIKELY_MATCH,
     NO_OBJECT_IN_START_REGION,
@@ -12,7 +13,6 @@ from learning.demonstration import (
     Snapshot,
     parse_action,
 )
-from learning.recipe import RecipeStep, load_builtin_recipe
 
 # A synthetic kitchen: region centres relative to the robot (metres) and the
 # appearance (r, g, b, length, width, height) of each object kind.

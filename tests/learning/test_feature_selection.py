@@ -11,7 +11,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from learning.feature_selection import (
+from learning.features.selection import (
     SELECTION_METHODS,
     backward_elimination,
     cfs_merit,
@@ -356,7 +356,7 @@ def test_bad_parameters_are_explained():
 
 
 def test_module_imports_no_simulator_viewer_or_application_code():
-    path = Path(__file__).resolve().parents[2] / "learning" / "feature_selection.py"
+    path = Path(__file__).resolve().parents[2] / "learning" / "features" / "selection.py"
     script = (
         "import importlib.util, sys\n"
         f"spec = importlib.util.spec_from_file_location('feature_selection', {str(path)!r})\n"
@@ -366,7 +366,7 @@ def test_module_imports_no_simulator_viewer_or_application_code():
     )
     result = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, check=True)
     assert result.stdout.strip() == "[]"
-    assert importlib.util.find_spec("learning.feature_selection") is not None
+    assert importlib.util.find_spec("learning.features.selection") is not None
 
 
 # ---------------------------------------------------------------- speed-ups keep the results
@@ -375,7 +375,7 @@ def test_module_imports_no_simulator_viewer_or_application_code():
 @settings(max_examples=40, deadline=None)
 @given(st.integers(0, 10_000), st.sampled_from([0.05, 0.5]))
 def test_forward_search_on_rows_on_demand_equals_the_full_matrix_search(seed, significance):
-    from learning.feature_selection import LazyCorrelations, _forward, _representatives, prepare
+    from learning.features.selection import LazyCorrelations, _forward, _representatives, prepare
 
     rng = np.random.default_rng(seed)
     n_samples, n_features = int(rng.integers(5, 120)), int(rng.integers(2, 30))

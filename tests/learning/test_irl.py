@@ -4,7 +4,9 @@ import numpy as np
 import pytest
 import torch
 
-from learning.irl import (
+from learning.decision.weights_file import load_weights, save_weights
+from learning.irl.demonstrations import DecisionTurn, QuestioningEpisode, turn_with_no_query
+from learning.irl.maxent import (
     IrlConfig,
     PaddedTurns,
     _TorchTurns,
@@ -12,11 +14,9 @@ from learning.irl import (
     fit_maxent_irl,
     split_episodes,
 )
-from learning.irl_data import DecisionTurn, QuestioningEpisode, turn_with_no_query
-from learning.irl_policy import agreement, greedy_choice
-from learning.irl_rollouts import FeatureMatchingConfig, fit_feature_matching
-from learning.irl_synthetic import DT_TASK_ENV_FEATURES, SyntheticQuestioningTask, greedy_policy, softmax_policy
-from learning.irl_weights import load_weights, save_weights
+from learning.irl.policy import agreement, greedy_choice
+from learning.irl.rollouts import FeatureMatchingConfig, fit_feature_matching
+from learning.irl.synthetic import DT_TASK_ENV_FEATURES, SyntheticQuestioningTask, greedy_policy, softmax_policy
 
 # a DT-task-env-like expert: wants learning progress, dislikes spending, dislikes sitting idle
 TRUE_WEIGHTS = np.array([1.0, 0.6, 0.4, 1.2, -1.5, 0.0, 0.8])
@@ -247,8 +247,8 @@ def test_a_failed_weights_write_keeps_the_old_file(tmp_path, monkeypatch):
     """save_weights writes beside the file and renames: a full disk mid-write leaves the old weights whole."""
     import pathlib
 
-    from learning.decision_weights import WEIGHTS_DIRECTORY
-    from learning.irl_weights import load_weights, save_weights
+    from learning.decision.weights import WEIGHTS_DIRECTORY
+    from learning.decision.weights_file import load_weights, save_weights
 
     weights = load_weights(WEIGHTS_DIRECTORY / "dt.toml")
     path = save_weights(tmp_path / "w.toml", weights)

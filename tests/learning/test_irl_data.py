@@ -8,7 +8,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from learning.irl_data import (
+from learning.decision.weights_file import DecisionWeights, load_weights, save_weights, weights_to_toml
+from learning.irl.demonstrations import (
     DecisionTurn,
     QuestioningEpisode,
     load_episode_dir,
@@ -16,8 +17,7 @@ from learning.irl_data import (
     save_episodes,
     turn_with_no_query,
 )
-from learning.irl_policy import agreement, greedy_choice, policy_probabilities, sample_choice
-from learning.irl_weights import DecisionWeights, load_weights, save_weights, weights_to_toml
+from learning.irl.policy import agreement, greedy_choice, policy_probabilities, sample_choice
 
 NAMES = ("acd", "cdu", "budget")
 

@@ -5,9 +5,9 @@ import json
 import numpy as np
 
 from dialog.cli import main
-from learning.decision_features import FEATURE_NAMES
-from learning.decision_weights import WEIGHTS_DIRECTORY, load_weight_file
-from learning.irl_weights import load_weights
+from learning.decision.features import FEATURE_NAMES
+from learning.decision.weights import WEIGHTS_DIRECTORY, load_weight_file
+from learning.decision.weights_file import load_weights
 
 LEARNED = WEIGHTS_DIRECTORY / "dt-task-env.toml"  # the dt-task-env preset carries the learned weights
 
@@ -45,7 +45,7 @@ def test_bad_demonstrations_get_one_clear_message(tmp_path, capsys):
 def test_the_gated_fit_asks_when_the_expert_asks_where_the_plain_softmax_stays_quiet():
     """The DT decides ask-or-not against its best query; a softmax over a dozen look-alike label queries can
     only explain an expert who asks half the time by making every single query worse than silence."""
-    from learning.irl_learn import learn_weights
+    from learning.irl.learn import learn_weights
 
     gated = learn_weights("shipped", policy="gated").weights.provenance
     softmax = learn_weights("shipped", policy="softmax").weights.provenance

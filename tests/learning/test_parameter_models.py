@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from scipy.stats import multivariate_normal
 
-from learning.parameter_models import ParameterModel
+from learning.recipes.parameter_models import ParameterModel
 
 STOVE = np.array([0.5, 0.4, 0.9])
 CUPBOARD = np.array([0.5, -0.5, 1.2])

@@ -2,7 +2,7 @@
 
 import pytest
 
-from learning.recipe import (
+from learning.recipes.format import (
     Recipe,
     RecipeStep,
     builtin_recipe_names,

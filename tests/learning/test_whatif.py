@@ -6,7 +6,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from learning.actions import FeatureQuery, LabelQuery
-from learning.decision import candidate_actions, expected_decision_features
+from learning.decision.candidates import candidate_actions, expected_decision_features
 from learning.gp import BinaryGPClassifier, rbf_kernel
 from learning.synthetic import SyntheticTask, random_state
 from learning.whatif import ENGINE_NAMES, make_engine

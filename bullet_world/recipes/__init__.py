@@ -1,0 +1,1 @@
+"""Recipe scenes in the simulator: layouts, set-up from task files, tracking objects."""

@@ -1,0 +1,66 @@
+"""Stored baselines: mean accuracy at checkpoints with tolerance bands; ``--check`` compares against them."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+
+from dialog.experiments.analysis import CheckpointSummary
+from dialog.experiments.suite import SUITE_DIR, Suite
+
+BASELINE_DIR = SUITE_DIR / "baselines"
+DEFAULT_TOLERANCE = 0.05
+
+
+def baseline_path(suite: Suite) -> Path:
+    return BASELINE_DIR / f"{suite.name}.json"
+
+
+def make_baseline(suite: Suite, summaries: list[CheckpointSummary], tolerance: float = DEFAULT_TOLERANCE) -> dict:
+    """Band = mean ± max(tolerance, 3 standard errors) at every checkpoint."""
+    bands: dict = {}
+    for s in summaries:
+        entry = bands.setdefault(s.condition, {}).setdefault(s.strategy, {})
+        for checkpoint, mean, error in zip(s.checkpoints, s.mean, s.error):
+            half = max(tolerance, 3.0 * float(error))
+            entry[str(checkpoint)] = {"mean": round(float(mean), 4),
+                                      "band": [round(float(mean) - half, 4), round(float(mean) + half, 4)]}
+    return {"suite": suite.name, "axis": suite.axis, "seeds": list(suite.seeds), "datasets": suite.datasets,
+            "bands": bands}
+
+
+def write_baseline(suite: Suite, summaries: list[CheckpointSummary], path: Path | None = None) -> Path:
+    path = path or baseline_path(suite)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(json.dumps(make_baseline(suite, summaries), indent=1) + "\n", encoding="utf-8")
+    return path
+
+
+def check_against_baseline(suite: Suite, summaries: list[CheckpointSummary], path: Path | None = None) -> list[str]:
+    """Readable differences for every checkpoint mean outside its stored band (empty: all inside)."""
+    path = path or baseline_path(suite)
+    if not path.exists():
+        return [f"no stored baseline for suite '{suite.name}' at {path}; run with --update-baseline first"]
+    try:
+        bands = json.loads(path.read_text(encoding="utf-8"))["bands"]
+    except (json.JSONDecodeError, KeyError) as error:
+        return [f"baseline {path} is unreadable ({error}); rewrite it with --update-baseline"]
+    axis = suite.axis  # questions, turns or demonstrations
+    failures = []
+    for s in summaries:
+        stored = bands.get(s.condition, {}).get(s.strategy)
+        if stored is None:
+            failures.append(f"{s.strategy}/{s.condition}: not in the baseline")
+            continue
+        for checkpoint, mean in zip(s.checkpoints, s.mean):
+            entry = stored.get(str(checkpoint))
+            if entry is None or not np.isfinite(mean):
+                continue
+            low, high = entry["band"]
+            if not low <= mean <= high:
+                side = "below" if mean < low else "above"
+                failures.append(f"{s.strategy}/{s.condition} after {checkpoint} {axis}: accuracy {mean:.3f} is "
+                                f"{side} its band [{low:.3f}, {high:.3f}] (baseline {entry['mean']:.3f})")
+    return failures

@@ -1,0 +1,106 @@
+"""One regression episode: a strategy, a condition, a training data set and a seed.
+
+Runs the real dialog manager with a scripted teacher on observation pools and
+returns the per-turn series the reports and baselines need.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+import numpy as np
+
+from dialog.experiments.pools import PoolEnvironment, load_pools
+from dialog.experiments.suite import Condition
+from dialog.manager import DialogManager, EpisodeConfig, episode_generators
+from dialog.threads import one_blas_thread
+from dialog.transcript import TranscriptWriter, read_transcript
+from learning.strategies import make_strategy
+
+SERIES = ("turn", "accuracy", "questions", "label", "demo", "feature", "spent")
+
+
+@dataclass(frozen=True)
+class EpisodeSpec:
+    suite: str
+    task: str
+    kitchen: str
+    strategy: str
+    condition: Condition
+    dataset: int
+    seed: int
+    costs: tuple  # ((kind, cost), ...), hashable
+    teacher: tuple  # ((option, value), ...)
+    transcript: str
+    plan: tuple = ()  # ((data-set plan option, value), ...), see dialog.experiments.pools.PLAN_OPTIONS
+
+    @property
+    def episode_seed(self) -> int:
+        """Scenes and teacher depend on the seed and data set, never on the strategy."""
+        return self.seed * 1000 + self.dataset
+
+    @property
+    def label(self) -> str:
+        return f"{self.strategy}/{self.condition.name}/d{self.dataset}/s{self.seed}"
+
+
+TEACHER_OPTIONS = ("kind", "mislabel_rate", "dont_know_rate", "feature_quality")
+
+
+def make_teacher(options: dict, rng: np.random.Generator):
+    """A scripted teacher (``kind = "scripted"``, the default; ``"oracle"`` = perfect) from suite options."""
+    from dialog.teachers import OracleTeacher, ScriptedTeacher
+
+    unknown = sorted(set(options) - set(TEACHER_OPTIONS))
+    kind = options.get("kind", "scripted")
+    if unknown or kind not in ("scripted", "oracle"):
+        raise ValueError(f"teacher options {options} not supported; accepted: kind = 'scripted' or 'oracle', "
+                         f"mislabel_rate, dont_know_rate, feature_quality (each 0..1)")
+    if kind == "oracle":
+        return OracleTeacher(rng)
+    return ScriptedTeacher(rng, **{k: float(v) for k, v in options.items() if k != "kind"})
+
+
+def run_episode(spec: EpisodeSpec) -> dict:
+    """Run one episode; returns its spec, per-turn series, final accuracy and wall time."""
+    with one_blas_thread():
+        return _run_episode(spec)
+
+
+def _run_episode(spec: EpisodeSpec) -> dict:
+    started = time.perf_counter()
+    pools = load_pools(spec.task, spec.kitchen, spec.dataset + 1, spec.plan)
+    condition = spec.condition
+    scenes = -(-condition.turns // max(condition.change_every, 1))
+    environment = PoolEnvironment(pools.train[spec.dataset], pools.test, pools.task, scenes)
+    config = EpisodeConfig(turns=condition.turns, budget=condition.budget, change_every=condition.change_every,
+                           seed=spec.episode_seed, costs=dict(spec.costs))
+    rngs = episode_generators(spec.episode_seed)
+    Path(spec.transcript).parent.mkdir(parents=True, exist_ok=True)
+    with TranscriptWriter(spec.transcript) as transcript:
+        result = DialogManager(environment, make_teacher(dict(spec.teacher), rngs["teacher"]),
+                               make_strategy(spec.strategy), config, transcript, rngs, say=lambda _: None).run()
+    series = series_from_transcript(read_transcript(spec.transcript))
+    return {"spec": asdict(spec), "label": spec.label, "series": series, "accuracy": result.accuracy,
+            "seconds": time.perf_counter() - started}
+
+
+def series_from_transcript(records: list[dict]) -> dict[str, list]:
+    """Per-turn cumulative counts and accuracy from a transcript."""
+    series = {name: [] for name in SERIES}
+    counts = {"label": 0, "demo": 0, "feature": 0}
+    spent = 0.0
+    for record in records:
+        kind = record["action"]["kind"]
+        if kind in counts:
+            counts[kind] += 1
+        spent += record["cost"]
+        series["turn"].append(record["turn"])
+        series["accuracy"].append(record["accuracy"])
+        series["questions"].append(sum(counts.values()))
+        for name in counts:
+            series[name].append(counts[name])
+        series["spent"].append(spent)
+    return series

@@ -1,0 +1,1 @@
+"""The feature-selection suite kind (thesis ch. 5 study)."""

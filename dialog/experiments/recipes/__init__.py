@@ -1,0 +1,1 @@
+"""The recipes suite kind (thesis ch. 4 experiments)."""

@@ -1,0 +1,151 @@
+"""Run a suite's episodes on local cores (with a progress bar) or on a Ray cluster."""
+
+from __future__ import annotations
+
+import os
+import signal
+import sys
+import threading
+from collections.abc import Callable
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from pathlib import Path
+
+from dialog.experiments.episodes import EpisodeSpec, run_episode
+from dialog.experiments.suite import Suite
+
+
+def episode_specs(suite: Suite, results_dir: Path) -> list[EpisodeSpec]:
+    """Every (condition, strategy, data set, seed) of the suite, in a stable order."""
+    specs = []
+    for condition in suite.conditions:
+        for strategy in suite.strategies:
+            for dataset in range(suite.datasets):
+                for seed in suite.seeds:
+                    transcript = results_dir / "transcripts" / condition.name / f"{strategy}-d{dataset}-s{seed}.jsonl"
+                    specs.append(EpisodeSpec(
+                        suite=suite.name, task=suite.task, kitchen=suite.kitchen, strategy=strategy,
+                        condition=condition, dataset=dataset, seed=seed, costs=tuple(sorted(suite.costs.items())),
+                        teacher=tuple(sorted(suite.teacher.items())), transcript=str(transcript),
+                        plan=suite.plan_options))
+    return specs
+
+
+def run_locally(specs: list[EpisodeSpec], workers: int | None = None, progress: bool = True) -> list[dict]:
+    """Run episodes in worker processes; results come back in the order of ``specs``."""
+    workers = max(1, min(workers or os.cpu_count() or 1, len(specs)))
+    results: list[dict | None] = [None] * len(specs)
+    with _progress(len(specs), progress) as advance:
+        if workers == 1:
+            for index, spec in enumerate(specs):
+                results[index] = run_episode(spec)
+                advance(spec.label)
+        else:
+            with ProcessPoolExecutor(max_workers=workers) as pool:
+                futures = {pool.submit(run_episode, spec): i for i, spec in enumerate(specs)}
+                for future in as_completed(futures):
+                    index = futures[future]
+                    results[index] = future.result()
+                    advance(specs[index].label)
+    return results
+
+
+def run_on_ray(specs: list[EpisodeSpec], address: str, progress: bool = True) -> list[dict]:
+    """Run the same episodes as Ray tasks on the cluster at ``address`` ("local" starts one here)."""
+    try:
+        import ray
+    except ImportError:
+        raise RuntimeError("--ray needs the optional extra: pip install 'teachbot[ray]'") from None
+    if address == "local":
+        start_local_ray(ray)
+    else:
+        print(f"teachbot regress: --ray {address}: this code runs on that cluster and its results are unpickled "
+              "here; name only a cluster you trust", file=sys.stderr)
+        ray.init(address=address, ignore_reinit_error=True, log_to_driver=False)
+    remote_episode = ray.remote(run_episode)
+    pending = {remote_episode.remote(spec): i for i, spec in enumerate(specs)}
+    results: list[dict | None] = [None] * len(specs)
+    with _progress(len(specs), progress) as advance:
+        while pending:
+            done, _ = ray.wait(list(pending), num_returns=1)
+            index = pending.pop(done[0])
+            results[index] = ray.get(done[0])
+            advance(specs[index].label)
+    return results
+
+
+LOCAL_RAY_ENVIRONMENT = {
+    "RAY_AUTH_MODE": "token",  # every Ray RPC carries the cluster's token (Ray writes it to ~/.ray/auth_token)
+    "RAY_ENABLE_WINDOWS_OR_OSX_CLUSTER": "0",  # a one-node instance: Ray binds its servers to 127.0.0.1
+}
+
+
+def start_local_ray(ray) -> None:
+    """Start a one-node Ray instance here, bound to 127.0.0.1, with token authentication, no dashboard.
+
+    Ray picks the loopback address when clusters are turned off (``RAY_ENABLE_WINDOWS_OR_OSX_CLUSTER=0``,
+    read at import and by the processes it starts). Token mode stays set: this process talks to the
+    instance with it. ``ray.init`` replaces the SIGTERM handler; it is put back so SIGTERM still ends
+    ``teachbot`` cleanly.
+    """
+    if ray.is_initialized():
+        return
+    mode = os.environ.get("RAY_AUTH_MODE", "token")
+    if mode.lower() != "token":
+        print(f"teachbot regress: RAY_AUTH_MODE={mode} ignored: --ray local always uses token authentication",
+              file=sys.stderr)
+    constants = ray._private.ray_constants
+    saved_variable = os.environ.get("RAY_ENABLE_WINDOWS_OR_OSX_CLUSTER")
+    saved_flag, saved_sigterm = constants.ENABLE_RAY_CLUSTER, signal.getsignal(signal.SIGTERM)
+    os.environ.update(LOCAL_RAY_ENVIRONMENT)
+    constants.ENABLE_RAY_CLUSTER = False  # in case ray was imported before the variable was set
+    try:
+        _reload_ray_settings(ray)
+        ray.init(include_dashboard=False, log_to_driver=False)
+        _check_token_mode(ray)
+    finally:
+        constants.ENABLE_RAY_CLUSTER = saved_flag
+        if saved_variable is None:
+            del os.environ["RAY_ENABLE_WINDOWS_OR_OSX_CLUSTER"]
+        else:
+            os.environ["RAY_ENABLE_WINDOWS_OR_OSX_CLUSTER"] = saved_variable
+        if saved_sigterm is not None and threading.current_thread() is threading.main_thread():
+            signal.signal(signal.SIGTERM, saved_sigterm)
+
+
+def _reload_ray_settings(ray) -> None:
+    """Make Ray's cached settings (read when ``ray`` was imported) see RAY_AUTH_MODE, as Ray does itself."""
+    config = getattr(getattr(ray, "_raylet", None), "Config", None)
+    if config is not None:
+        config.initialize("")
+
+
+def _check_token_mode(ray) -> None:
+    mode = getattr(getattr(ray, "_raylet", None), "get_authentication_mode", None)
+    if mode is None or mode() != ray._raylet.AuthenticationMode.TOKEN:
+        ray.shutdown()
+        raise RuntimeError(f"--ray local needs token authentication, which Ray {ray.__version__} does not offer "
+                           "(it came in Ray 2.52): pip install 'ray>=2.52'")
+
+
+class _progress:
+    """A rich progress bar on standard error (kept off standard output, which may carry JSON)."""
+
+    def __init__(self, total: int, enabled: bool):
+        self.total, self.enabled = total, enabled
+
+    def __enter__(self) -> Callable[[str], None]:
+        if not self.enabled:
+            return lambda label: None
+        from rich.console import Console
+        from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+
+        console = Console(file=sys.stderr)
+        self._bar = Progress(TextColumn("episodes"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
+                             TextColumn("{task.description}"), console=console, transient=not console.is_terminal)
+        self._bar.start()
+        task = self._bar.add_task("", total=self.total)
+        return lambda label: self._bar.update(task, advance=1, description=label)
+
+    def __exit__(self, *exc) -> None:
+        if self.enabled:
+            self._bar.stop()

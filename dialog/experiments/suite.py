@@ -1,0 +1,230 @@
+"""Regression suites as TOML files (``dialog/suites/NAME.toml``), validated with clear messages.
+
+A suite names a task, the strategies to compare, the conditions (budget, turns,
+change rate), how many training data sets, the checkpoints at which accuracy is
+compared, and the thesis findings to test. See ``dialog/suites/README.md``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+from learning.actions import DEFAULT_COSTS
+from learning.datafiles import check_keys, integer, number, numbers, read_toml, section, tables, text, texts
+from learning.errors import DataFileError
+from learning.significance import ALTERNATIVES
+
+SUITE_DIR = Path(__file__).resolve().parents[1] / "suites"
+KINDS = ("episodes", "feature-selection", "recipes")
+AXES = ("questions", "turns", "demonstrations")
+SUITE_FIELDS = ("name", "description", "analysis", "kind", "task", "kitchen", "strategies", "datasets", "seeds",
+                "checkpoints", "axis", "costs", "teacher", "options", "dataset", "condition", "finding")
+CONDITION_FIELDS = ("name", "budget", "turns", "change_every")
+FINDING_FIELDS = ("id", "text", "condition", "at", "better", "than", "alternative", "than_at", "margin")
+TEACHER_KINDS = ("scripted", "oracle")
+TEACHER_RATES = ("mislabel_rate", "dont_know_rate", "feature_quality")
+PLAN_FIELDS = ("pools", "pool_size", "test_size", "objects_per_scene")
+FEATURE_OPTIONS = ("samples", "users", "relevant_features", "user_model")
+USER_MODEL_FIELDS = ("keep_relevant", "add_irrelevant", "ignore_robot", "ignore_irrelevant_object", "ignore_relevant")
+
+
+class SuiteError(DataFileError):
+    """A suite file is missing, malformed, or asks for something that does not exist."""
+
+
+@dataclass(frozen=True)
+class Condition:
+    name: str
+    budget: float
+    turns: int
+    change_every: int
+
+
+@dataclass(frozen=True)
+class Finding:
+    """A claim from the thesis to test: ``better`` beats each of ``than`` at checkpoint ``at``."""
+
+    id: str
+    text: str
+    condition: str
+    at: int
+    better: str
+    than: tuple[str, ...]
+    alternative: str = "greater"
+    than_at: int | None = None  # recipes suites: compare with ``than`` at this checkpoint instead of ``at``
+    margin: float = 0.0         # recipes suites: ``better`` + margin beats ``than`` (non-inferiority)
+
+
+@dataclass(frozen=True)
+class Suite:
+    name: str
+    description: str
+    kind: str
+    task: str
+    kitchen: str
+    strategies: tuple[str, ...]
+    conditions: tuple[Condition, ...]
+    datasets: int
+    seeds: tuple[int, ...]
+    checkpoints: tuple[int, ...]
+    axis: str
+    costs: dict
+    teacher: dict
+    findings: tuple[Finding, ...] = ()
+    options: dict = field(default_factory=dict)
+    path: str = ""
+    dataset: dict = field(default_factory=dict)  # overrides of the task's data-set plan ([dataset] table)
+    analysis: str = ""  # where the written analysis of the findings lives (shown in the report)
+
+    @property
+    def plan_options(self) -> tuple:
+        """The ``[dataset]`` table as a hashable ((name, value), ...) for ``pools.load_pools``."""
+        return tuple(sorted(self.dataset.items()))
+
+    def with_overrides(self, strategies=None, seeds=None, budget=None, datasets=None) -> Suite:
+        """The suite with command-line overrides applied."""
+        suite = self
+        if strategies:
+            suite = replace(suite, strategies=tuple(strategies), findings=tuple(
+                f for f in suite.findings if f.better in strategies and set(f.than) <= set(strategies)))
+        if seeds:
+            suite = replace(suite, seeds=tuple(seeds))
+        if budget is not None:
+            suite = replace(suite, conditions=tuple(replace(c, budget=float(budget)) for c in suite.conditions))
+        if datasets:
+            suite = replace(suite, datasets=int(datasets))
+        return suite
+
+
+def suite_names() -> list[str]:
+    return sorted(p.stem for p in SUITE_DIR.glob("*.toml"))
+
+
+def _read(path: Path) -> dict:
+    try:
+        return read_toml(path, "suite")
+    except DataFileError as error:
+        raise SuiteError(str(error)) from None
+
+
+def load_suite(name_or_path: str | Path, known_strategies=None) -> Suite:
+    """Load and validate a suite by name (``dialog/suites/NAME.toml``) or path."""
+    path = Path(name_or_path)
+    if path.suffix != ".toml":
+        path = SUITE_DIR / f"{name_or_path}.toml"
+        if not path.exists():
+            raise SuiteError(f"unknown suite '{name_or_path}'; available: {', '.join(suite_names())}")
+    table = _read(path)
+    where = str(path)
+    try:
+        return _suite(table, where, known_strategies)
+    except SuiteError:
+        raise
+    except DataFileError as error:
+        raise SuiteError(str(error)) from None
+
+
+def _suite(table: dict, where: str, known_strategies) -> Suite:
+    check_keys(table, where, required=("name", "strategies", "checkpoints"), optional=SUITE_FIELDS)
+    kind = text(table, "kind", where, "episodes", choices=KINDS)
+    strategies = texts(table, "strategies", where, nonempty=True)
+    if known_strategies is not None and kind == "episodes":
+        unknown = [s for s in strategies if s not in known_strategies]
+        if unknown:
+            raise SuiteError(f"{where}: unknown strategies {unknown}; known: {', '.join(known_strategies)}")
+    conditions = tuple(_condition(c, f"{where} condition {i + 1}") for i, c in enumerate(tables(table, "condition",
+                                                                                                 where, [])))
+    if kind == "episodes" and not conditions:
+        raise SuiteError(f"{where}: an episodes suite needs at least one [[condition]]")
+    names = [c.name for c in conditions]
+    if len(set(names)) != len(names):
+        raise SuiteError(f"{where}: condition names must be unique, got {names}")
+    findings = tuple(_finding(f, kind, strategies, names, f"{where} finding {i + 1}")
+                     for i, f in enumerate(tables(table, "finding", where, [])))
+    return Suite(
+        name=text(table, "name", where), description=text(table, "description", where, "", nonempty=False),
+        kind=kind, task=text(table, "task", where, "pack-lunchbox"), kitchen=text(table, "kitchen", where, "kitchen-1"),
+        strategies=strategies, conditions=conditions, datasets=integer(table, "datasets", where, 5, low=1),
+        seeds=numbers(table, "seeds", where, (0,), whole=True, low=0),
+        checkpoints=numbers(table, "checkpoints", where, whole=True, low=0),
+        axis=text(table, "axis", where, "questions", choices=AXES), costs=_costs(table, where),
+        teacher=_teacher(table, where), findings=findings, options=_options(table, kind, where), path=where,
+        dataset=_plan(table, where), analysis=text(table, "analysis", where, "", nonempty=False),
+    )
+
+
+def _condition(table: dict, where: str) -> Condition:
+    check_keys(table, where, required=CONDITION_FIELDS)
+    return Condition(text(table, "name", where), number(table, "budget", where, low=0.0),
+                     integer(table, "turns", where, low=1), integer(table, "change_every", where, low=1))
+
+
+def _finding(table: dict, kind: str, strategies: tuple, conditions: list, where: str) -> Finding:
+    check_keys(table, where, required=("id", "text", "at", "better", "than"), optional=FINDING_FIELDS)
+    at = integer(table, "at", where, low=0)
+    default_condition = f"n{at}" if kind == "feature-selection" else ""
+    finding = Finding(text(table, "id", where), text(table, "text", where),
+                      text(table, "condition", where, default_condition), at, text(table, "better", where),
+                      texts(table, "than", where, nonempty=True),
+                      text(table, "alternative", where, "greater", choices=ALTERNATIVES),
+                      *_recipe_finding_extras(table, kind, where))
+    missing = [s for s in (finding.better, *finding.than) if s not in strategies]
+    if missing:
+        raise SuiteError(f"{where}: strategies {missing} are not in the suite's strategies")
+    if conditions and finding.condition not in conditions:
+        raise SuiteError(f"{where}: condition '{finding.condition}' is not one of {conditions}")
+    return finding
+
+
+def _costs(table: dict, where: str) -> dict:
+    """The [costs] table: every action kind (label, demo, feature, none) with a finite cost >= 0."""
+    costs = section(table, "costs", where, None)
+    if costs is None:
+        return {}
+    check_keys(costs, f"{where} [costs]", required=tuple(DEFAULT_COSTS))
+    for kind in DEFAULT_COSTS:
+        number(costs, kind, f"{where} [costs]", low=0.0)
+    return {kind: costs[kind] for kind in DEFAULT_COSTS}  # as written (1 stays 1 in transcripts and baselines)
+
+
+def _teacher(table: dict, where: str) -> dict:
+    """The [teacher] table: kind (scripted or oracle) and the scripted teacher's rates, each 0..1."""
+    teacher, here = section(table, "teacher", where, {}), f"{where} [teacher]"
+    check_keys(teacher, here, optional=("kind", *TEACHER_RATES))
+    result = {"kind": text(teacher, "kind", here, choices=TEACHER_KINDS)} if "kind" in teacher else {}
+    return result | {key: number(teacher, key, here, low=0.0, high=1.0) for key in TEACHER_RATES if key in teacher}
+
+
+def _plan(table: dict, where: str) -> dict:
+    """The [dataset] table: overrides of the task's data-set plan, whole numbers >= 1."""
+    plan, here = section(table, "dataset", where, {}), f"{where} [dataset]"
+    check_keys(plan, here, optional=PLAN_FIELDS)
+    return {key: integer(plan, key, here, low=1) for key in plan}
+
+
+def _options(table: dict, kind: str, where: str) -> dict:
+    """[options]: none for episodes; the study's settings for feature-selection; recipes: see recipe_suite."""
+    options, here = section(table, "options", where, {}), f"{where} [options]"
+    if kind == "episodes":
+        check_keys(options, here)
+    elif kind == "feature-selection":
+        check_keys(options, here, optional=FEATURE_OPTIONS)
+        integer(options, "samples", here, 10, low=1)
+        integer(options, "users", here, 10, low=1)
+        texts(options, "relevant_features", here, ())
+        user_model = section(options, "user_model", here, {})
+        check_keys(user_model, f"{here} user_model", optional=USER_MODEL_FIELDS)
+        for key in user_model:
+            number(user_model, key, f"{here} user_model", low=0.0, high=1.0)
+    return dict(options)
+
+
+def _recipe_finding_extras(table: dict, kind: str, where: str) -> tuple[int | None, float]:
+    """``than_at`` and ``margin`` of a finding: only a recipes suite compares across checkpoints."""
+    if kind != "recipes":
+        extra = [key for key in ("than_at", "margin") if key in table]
+        if extra:
+            raise SuiteError(f"{where}: '{extra[0]}' is only accepted in a suite of kind 'recipes'")
+        return None, 0.0
+    return integer(table, "than_at", where, None, low=0), number(table, "margin", where, 0.0, low=0.0)

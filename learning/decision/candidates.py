@@ -1,0 +1,130 @@
+"""Expected decision features of every candidate action: the input to DT and to IRL (thesis eq. 6.3, 7.1, 7.2).
+
+For a learning state s and each affordable candidate a, ``expected_decision_features``
+returns E[phi(s') | a] = sum_{s'} P(s' | a) phi(s'), so that with the linear
+utility U(s) = w . phi(s) the expected utility is EU(a) = w . E[phi(s') | a].
+
+* DemoQuery(y): the teacher shows scene object x with p(x|y) = p(y|x) / sum_x' p(y|x')
+  (the per-concept classifier's probabilities, normalised over the scene).
+* LabelQuery(x): the teacher names concept y with p(y|x) normalised over the concepts.
+* FeatureQuery: every classifier switches to F_{y,c} with probability 1/|Y| each.
+* Every query's next state has spent + cost, one more turn gone and t_NQ = 0.
+* NoQuery's row is phi(s) itself, so "argmax over all rows" is the thesis rule
+  "take a* only if EU(a*) > U(s)" (eq. 6.3); ties go to no query.
+
+Candidates, in this fixed order: a DemoQuery per concept (state.concepts
+order; not for a concept the teacher could not show in this scene), a
+LabelQuery per scene object not yet labelled in this scene (index order), the
+FeatureQuery until it has been asked, NoQuery last. Only queries the remaining
+budget covers are candidates.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from learning.actions import Action, DemoQuery, FeatureQuery, LabelQuery, NoQuery
+from learning.decision.features import (
+    FEATURE_NAMES,
+    concept_counts,
+    features,
+    label_distribution,
+    learning_features,
+    state_clock,
+)
+from learning.whatif import WhatIfEngine, make_engine
+
+
+@dataclass(frozen=True)
+class CandidateFeatures:
+    """One turn's candidates and E[phi(s') | a] for each (rows in ``actions`` order, columns FEATURE_NAMES)."""
+
+    actions: tuple[Action, ...]
+    expected: np.ndarray  # (len(actions), len(FEATURE_NAMES))
+    current: np.ndarray  # phi(s), (len(FEATURE_NAMES),); equal to the NoQuery row
+    feature_names: tuple[str, ...] = FEATURE_NAMES
+
+    def utilities(self, weights) -> np.ndarray:
+        """EU(a) = w . E[phi(s') | a] for every candidate (eq. 7.1, 7.2)."""
+        return self.expected @ np.asarray(weights, dtype=float)
+
+    @property
+    def no_query_index(self) -> int:
+        return len(self.actions) - 1
+
+    @property
+    def kinds(self) -> tuple[str, ...]:
+        return tuple(action.kind for action in self.actions)
+
+
+def candidate_actions(state) -> tuple[Action, ...]:
+    """The affordable candidates of this turn in the fixed order (module docstring); NoQuery is always last."""
+    n_objects = len(state.scene_X)
+    labelled = state.labelled_in_scene
+    # A demonstration is drawn from the scene: none without objects, nor for a concept the teacher
+    # already could not find in this scene.
+    queries: list[Action] = [DemoQuery(c) for c in state.concepts if n_objects and c not in state.absent_in_scene]
+    queries += [LabelQuery(i) for i in range(n_objects) if i not in labelled]
+    if not state.feature_query_asked:
+        queries.append(FeatureQuery())
+    return tuple(a for a in queries if state.can_afford(a)) + (NoQuery(),)
+
+
+def expected_decision_features(state, engine: str | WhatIfEngine = "fast", window_factor: float = 1.0,
+                               actions: tuple[Action, ...] | None = None) -> CandidateFeatures:
+    """E[phi(s') | a] for every candidate action of ``state`` (thesis eq. 6.3, 7.1) with the given what-if engine.
+
+    ``actions`` defaults to ``candidate_actions(state)``; a caller may pass a subset (NoQuery included or not).
+    """
+    engine = make_engine(engine)
+    actions = candidate_actions(state) if actions is None else tuple(actions)
+    clock = state_clock(state, window_factor)
+    counts = concept_counts(state)
+    P = state.probabilities()
+    current = features(P, counts, clock)
+    label_objects = [a.object_index for a in actions if a.kind == "label"]
+    wants_feature_query = any(a.kind == "feature" for a in actions)
+    if not (label_objects or wants_feature_query or any(a.kind == "demo" for a in actions)):
+        return CandidateFeatures(actions, np.tile(current, (len(actions), 1)), current)
+    outcomes = engine.simulate(state, label_objects, wants_feature_query)
+    n_concepts = len(state.concepts)
+    with_one_more = counts + np.eye(n_concepts)  # row y: the counts after one more example of concept y
+    # Learning features of every simulated next state, all at once: (|Y|, |X|, 4), (k, |Y|, 4), (|Y|, 4).
+    demo_phi = learning_features(outcomes.demo, with_one_more[:, None, :])
+    if outcomes.shared:  # the same <x, y> states: score them once
+        label_phi = demo_phi[:, list(outcomes.label_objects)].transpose(1, 0, 2)
+    else:
+        label_phi = learning_features(outcomes.label, with_one_more[None, :, :])
+    feature_phi = None if outcomes.feature is None else learning_features(outcomes.feature, counts)
+    label_rows = {index: k for k, index in enumerate(outcomes.label_objects)}
+    concept_index = {c: k for k, c in enumerate(state.concepts)}
+    expected = np.empty((len(actions), len(current)))
+    learned = expected[:, : demo_phi.shape[-1]]
+    positions = {kind: [i for i, a in enumerate(actions) if a.kind == kind] for kind in ("demo", "label", "feature")}
+    if positions["demo"]:  # the teacher's object x with p(x|y), the classifier's column normalised over the scene
+        ys = [concept_index[actions[i].concept] for i in positions["demo"]]
+        weights = np.array([_normalised(P[:, y]) for y in ys])
+        learned[positions["demo"]] = np.einsum("dx,dxk->dk", weights, demo_phi[ys])
+    if positions["label"]:  # the teacher's concept y with p(y|x) normalised over the concepts
+        objects = [actions[i].object_index for i in positions["label"]]
+        rows = [label_rows[x] for x in objects]
+        learned[positions["label"]] = np.einsum("ly,lyk->lk", label_distribution(P)[objects], label_phi[rows])
+    if positions["feature"]:  # each F_{y,c} with probability 1/|Y|
+        learned[positions["feature"]] = feature_phi.mean(axis=0)
+    after = {}  # the next turn's environment features, per query cost
+    for i, action in enumerate(actions):
+        if action.kind == "none":
+            expected[i] = current
+            continue
+        cost = state.cost(action)
+        if cost not in after:
+            after[cost] = clock.after(cost, asked=True).features()
+        expected[i, learned.shape[1] :] = after[cost]
+    return CandidateFeatures(actions, expected, current)
+
+
+def _normalised(column: np.ndarray) -> np.ndarray:
+    total = column.sum()
+    return column / total if total > 0 else np.full(len(column), 1.0 / max(len(column), 1))

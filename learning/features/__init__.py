@@ -1,0 +1,1 @@
+"""Feature selection for concept grounding (thesis ch. 5): FI, ES, ER and their information measures."""

@@ -1,0 +1,117 @@
+"""``teachbot learn-weights``: DT-task-env weights from expert demonstrations (thesis §7.3.2, §7.4.1).
+
+Load the demonstrations (a directory of .json/.npz files, one file, or the
+shipped ones in learning/irl/expert-demos/), hold out whole episodes for
+validation (by default all but three train, as the thesis trained on three
+expert episodes; at least one validates), fit per-turn maximum-entropy IRL
+(``learning.irl.maxent.fit_maxent_irl``, eq. 7.5-7.7, at most 100 iterations) and keep
+the iterate that does best on the validation episodes.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from learning.decision.features import FEATURE_NAMES
+from learning.decision.weights_file import DecisionWeights
+from learning.irl.demonstrations import QuestioningEpisode, load_episode_dir, load_episodes
+from learning.irl.policy import greedy_choice
+
+SHIPPED = "shipped"
+SHIPPED_DEMOS = Path(__file__).resolve().parent / "expert-demos"
+THESIS_TRAINING_EPISODES = 3
+
+
+def load_demonstrations(spec: str | Path) -> list[QuestioningEpisode]:
+    """Episodes from ``shipped``, a directory of .json/.npz files or one such file; clear errors otherwise."""
+    path = SHIPPED_DEMOS if str(spec) == SHIPPED else Path(spec)
+    if not path.exists():
+        raise FileNotFoundError(f"--demos {spec}: no such file or directory; give a directory of .json/.npz "
+                                "demonstration files, one such file, or the word 'shipped'")
+    episodes = load_episode_dir(path) if path.is_dir() else load_episodes(path)
+    names = episodes[0].feature_names
+    if tuple(names) != FEATURE_NAMES:
+        raise ValueError(f"--demos {spec}: the demonstrations record the features {list(names)}; DT-task-env weighs "
+                         f"{list(FEATURE_NAMES)} (in that order)")
+    return episodes
+
+
+def default_validation_count(n_episodes: int) -> int:
+    """All but three episodes validate (the thesis trained on three); at least one does."""
+    if n_episodes < 2:
+        raise ValueError(f"learning weights needs at least 2 demonstration episodes (one to train, one to "
+                         f"validate), got {n_episodes}")
+    return max(1, n_episodes - THESIS_TRAINING_EPISODES)
+
+
+def decision_agreement(episodes, weights: np.ndarray) -> dict[str, float]:
+    """Beyond exact agreement: how often w asks when the expert asks (or keeps quiet when it does), and picks the
+    same kind of action (label, demo, feature, none), over the turns with a choice."""
+    same_ask, same_kind, counted = 0, 0, 0
+    for episode in episodes:
+        for turn in episode.turns:
+            if turn.n_actions < 2 or turn.kinds is None:
+                continue
+            ours = greedy_choice(turn, weights)
+            counted += 1
+            same_ask += (turn.kinds[ours] == "none") == (turn.kinds[turn.chosen] == "none")
+            same_kind += turn.kinds[ours] == turn.kinds[turn.chosen]
+    if not counted:
+        return {}
+    return {"ask_or_quiet_agreement": same_ask / counted, "action_kind_agreement": same_kind / counted}
+
+
+@dataclass(frozen=True)
+class LearnedWeights:
+    weights: DecisionWeights
+    result: object  # learning.irl.maxent.IrlResult
+    train: list
+    validation: list
+    seconds: float  # loading, splitting and fitting
+
+    def summary(self) -> dict:
+        """The last stdout line of ``teachbot learn-weights``."""
+        return {"iterations": self.result.iterations, "seconds": round(self.seconds, 3),
+                "weights": self.weights.as_dict(), "validation_agreement": self.result.validation_agreement}
+
+
+def learn_weights(demos: str | Path, iterations: int = 100, seed: int = 0,
+                  n_validation: int | None = None, policy: str = "gated") -> LearnedWeights:
+    """Load, split (seeded), fit and package the weights with a [provenance] table (method maxent-irl).
+
+    ``policy="gated"`` (default) fits the DT's own ask-or-not-then-which rule; ``"softmax"`` the plain
+    per-turn softmax over all candidates (see ``learning.irl.maxent._TorchTurns``)."""
+    started = time.perf_counter()
+    from learning.irl.maxent import IrlConfig, fit_maxent_irl, split_episodes  # torch: only when fitting
+
+    episodes = load_demonstrations(demos)
+    n_validation = default_validation_count(len(episodes)) if n_validation is None else n_validation
+    train, validation = split_episodes(episodes, n_validation, np.random.default_rng(seed))
+    result = fit_maxent_irl(train, validation, IrlConfig(max_iterations=iterations, seed=seed, policy=policy))
+    fitted = result.weights.provenance
+    diagnostics = decision_agreement(validation, result.weights.values)
+    provenance = {"method": "maxent-irl", "variant": fitted["method"], "policy": fitted["policy"],
+                  "optimizer": fitted["optimizer"],
+                  "l2": fitted["l2"], "select_by": fitted["select_by"],
+                  "demos": SHIPPED if str(demos) == SHIPPED else str(demos),
+                  "train_episodes": ", ".join(e.name for e in train),
+                  "validation_episodes": ", ".join(e.name for e in validation), "seed": seed,
+                  "max_iterations": iterations, "iterations": result.iterations,
+                  "best_iteration": result.best_iteration, "train_turns": result.train_turns,
+                  "train_agreement": round(result.train_agreement, 6),
+                  "validation_turns": result.validation_turns,
+                  "validation_agreement": round(result.validation_agreement, 6),
+                  **{f"validation_{key}": round(value, 6) for key, value in diagnostics.items()},
+                  "unidentified_features": ", ".join(result.unidentified_features) or "none"}
+    weights = DecisionWeights(result.weights.feature_names, result.weights.values, provenance)
+    return LearnedWeights(weights, result, train, validation, time.perf_counter() - started)
+
+
+def weights_comment(learned: LearnedWeights) -> str:
+    return (f"DT-task-env weights (thesis eq. 7.2) learned by maximum-entropy IRL (eq. 7.5-7.7) from "
+            f"{len(learned.train)} expert episodes,\nthe iterate best on {len(learned.validation)} held-out "
+            f"episode(s). Written by `teachbot learn-weights`; docs/irl.md.")
