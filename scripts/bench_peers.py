@@ -1,0 +1,212 @@
+"""teachbot's questioning against scikit-activeml's on the same pools, with the same oracle teacher.
+
+Data: scikit-learn's bundled iris, wine and breast-cancer sets (nobody here wrote them). Each repeat
+splits a data set into a pool and a held-out test set (stratified, seeded), then draws the same
+sequence of scenes for every method: ``--objects`` pool rows, a new scene every ``--change-every``
+turns, ``--turns`` turns, ``--budget`` cost units (label 1, demonstration 2, feature query 2).
+
+Methods:
+- ``teachbot-dt``: TeachingLoop(strategy="dt-task"), the decision-theoretic choice among label,
+  demonstration, feature and no query. The oracle labels objects, demonstrates a scene object of the
+  asked concept (None if the scene has none) and skips the feature query (it knows no feature truth).
+- ``teachbot-entropy``: TeachingLoop(strategy="active"), entropy sampling with label queries only.
+- ``skactiveml-us``: UncertaintySampling(method="entropy"), and ``skactiveml-eer``: MonteCarloEER
+  (misclassification loss), both on scikit-learn's GaussianProcessClassifier with teachbot's fixed kernel
+  (4.0 * RBF(sqrt |F|), no optimiser) on pool-standardised features; one label query per turn while the
+  budget lasts, among the scene objects not yet labelled in this scene.
+
+Timing: one decision is ``TeachingLoop.ask()`` or ``query()``; refitting after an answer is outside it
+(``tell`` for teachbot; for UncertaintySampling the classifier is fitted after each label and ``query``
+gets ``fit_clf=False``). MonteCarloEER must fit inside ``query`` (it refits per candidate and answer on
+the labelled rows it is given), so its time holds one extra fit on those few labels.
+Turns with the budget spent are not timed. Accuracy is on the test set after the last turn.
+Needs the ``peers`` extra (``pip install -e .[peers]``).
+
+    python scripts/bench_peers.py --json          # last line: one JSON object
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import time
+import warnings
+
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+import numpy as np  # noqa: E402
+from sklearn.datasets import load_breast_cancer, load_iris, load_wine  # noqa: E402
+from sklearn.gaussian_process import GaussianProcessClassifier  # noqa: E402
+from sklearn.gaussian_process.kernels import RBF, ConstantKernel  # noqa: E402
+from sklearn.model_selection import train_test_split  # noqa: E402
+
+from learning import TeachingLoop  # noqa: E402
+
+DATASETS = {"iris": load_iris, "wine": load_wine, "breast-cancer": load_breast_cancer}
+METHODS = ("teachbot-dt", "teachbot-entropy", "skactiveml-us", "skactiveml-eer")
+RATIOS = (("teachbot-dt", "skactiveml-eer"), ("teachbot-entropy", "skactiveml-us"))
+
+
+def _parse(argv):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--datasets", nargs="+", default=["iris", "wine"], choices=sorted(DATASETS))
+    parser.add_argument("--repeats", type=int, default=5, help="seeded pool/test splits per data set (default 5)")
+    parser.add_argument("--turns", type=int, default=30)
+    parser.add_argument("--budget", type=float, default=20.0)
+    parser.add_argument("--objects", type=int, default=12, help="pool rows per scene (default 12)")
+    parser.add_argument("--change-every", type=int, default=5)
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--json", action="store_true", help="end with one JSON line")
+    args = parser.parse_args(argv)
+    for name in ("repeats", "turns", "objects", "change_every"):
+        if getattr(args, name) < 1:
+            parser.error(f"--{name.replace('_', '-')} must be at least 1, got {getattr(args, name)}")
+    return args
+
+
+def scenes_for(pool_size: int, args, rng: np.random.Generator) -> list[np.ndarray]:
+    """Pool indices of each scene, the same for every method."""
+    count = -(-args.turns // args.change_every)
+    return [rng.choice(pool_size, min(args.objects, pool_size), replace=False) for _ in range(count)]
+
+
+def run_teachbot(strategy: str, X, y, scenes, X_test, y_test, args, seed: int) -> dict:
+    loop = TeachingLoop(np.unique(y), strategy=strategy, budget=args.budget, turns=args.turns,
+                        change_every=args.change_every, seed=seed)
+    times, index = [], None
+    for turn in range(args.turns):
+        if turn % args.change_every == 0:
+            index = scenes[turn // args.change_every]
+            loop.observe(X[index])
+        can_ask = loop.budget_left >= min(loop.costs[k] for k in ("label", "demo", "feature"))
+        start = time.perf_counter()
+        query = loop.ask()
+        if can_ask:  # turns with the budget spent are no decisions (the peers time none either)
+            times.append(time.perf_counter() - start)
+        truth = y[index]
+        if query.kind == "label":
+            loop.tell(truth[query.object])
+        elif query.kind == "demo":
+            members = np.flatnonzero(truth == query.concept)
+            loop.tell(int(members[0]) if len(members) else None)
+        else:
+            loop.tell(None)
+    kinds = [t.query.kind for t in loop.history]
+    return {"accuracy": float(np.mean(loop.predict(X_test) == y_test)), "times": times,
+            "queries": {k: kinds.count(k) for k in ("label", "demo", "feature", "none")}}
+
+
+class UnweightedGPClassifier(GaussianProcessClassifier):
+    """scikit-learn's GP classifier with the ``sample_weight`` argument MonteCarloEER passes (only unit weights)."""
+
+    def fit(self, X, y, sample_weight=None):
+        if sample_weight is not None and not np.allclose(sample_weight, 1.0):
+            raise ValueError("GaussianProcessClassifier takes no sample weights other than 1")
+        return super().fit(X, y)
+
+
+def peer_classifier(classes, n_features: int, seed: int):
+    from skactiveml.classifier import SklearnClassifier
+
+    kernel = ConstantKernel(4.0, "fixed") * RBF(np.sqrt(n_features), "fixed")
+    return SklearnClassifier(UnweightedGPClassifier(kernel=kernel, optimizer=None), classes=classes,
+                             missing_label=-1, random_state=seed)
+
+
+def run_peer(method: str, X, y, scenes, X_test, y_test, args, seed: int) -> dict:
+    from skactiveml.pool import MonteCarloEER, UncertaintySampling
+
+    mean, std = X.mean(axis=0), np.where(X.std(axis=0) > 0, X.std(axis=0), 1.0)
+    Xs, Xs_test = (X - mean) / std, (X_test - mean) / std
+    classes = np.unique(y)
+    chooser = UncertaintySampling(method="entropy", missing_label=-1, random_state=seed) \
+        if method == "skactiveml-us" else MonteCarloEER(missing_label=-1, random_state=seed)
+    clf = peer_classifier(classes, X.shape[1], seed)
+    labelled_X, labelled_y = np.zeros((0, X.shape[1])), np.zeros(0, dtype=int)
+    clf.fit(labelled_X, labelled_y)
+    budget, times, asked = args.budget, [], set()
+    for turn in range(args.turns):
+        index = scenes[turn // args.change_every]
+        if turn % args.change_every == 0:
+            asked = set()
+        candidates = [i for i in range(len(index)) if i not in asked]
+        if budget < 1 or not candidates:
+            continue
+        X_all = np.vstack([labelled_X, Xs[index]])
+        y_all = np.concatenate([labelled_y, np.full(len(index), -1)])
+        start = time.perf_counter()
+        chosen = chooser.query(X_all, y_all, clf, fit_clf=method == "skactiveml-eer",
+                               candidates=np.array(candidates) + len(labelled_X))
+        times.append(time.perf_counter() - start)
+        pick = int(chosen[0]) - len(labelled_X)
+        asked.add(pick)
+        budget -= 1
+        labelled_X = np.vstack([labelled_X, Xs[index[pick]]])
+        labelled_y = np.append(labelled_y, y[index[pick]])
+        clf.fit(labelled_X, labelled_y)
+    labels = int(len(labelled_y))
+    return {"accuracy": float(np.mean(clf.predict(Xs_test) == y_test)), "times": times,
+            "queries": {"label": labels, "demo": 0, "feature": 0, "none": args.turns - labels}}
+
+
+def summarise(runs: list[dict]) -> dict:
+    times = np.array([t for run in runs for t in run["times"]]) * 1000.0
+    accuracies = [run["accuracy"] for run in runs]
+    queries = {k: float(np.mean([run["queries"][k] for run in runs])) for k in ("label", "demo", "feature", "none")}
+    return {"accuracy_mean": round(float(np.mean(accuracies)), 4), "accuracy_std": round(float(np.std(accuracies)), 4),
+            "decision_p50_ms": round(float(np.percentile(times, 50)), 3),
+            "decision_p95_ms": round(float(np.percentile(times, 95)), 3), "queries_mean": queries}
+
+
+def benchmark(args) -> dict:
+    results = {}
+    for name in args.datasets:
+        X_all, y_all = DATASETS[name](return_X_y=True)
+        runs = {method: [] for method in METHODS}
+        for repeat in range(args.repeats):
+            seed = args.seed + repeat
+            X, X_test, y, y_test = train_test_split(X_all, y_all, test_size=0.3, stratify=y_all, random_state=seed)
+            scenes = scenes_for(len(y), args, np.random.default_rng(seed))
+            for method in METHODS:
+                run = run_teachbot if method.startswith("teachbot") else run_peer
+                strategy = {"teachbot-dt": "dt-task", "teachbot-entropy": "active"}.get(method, method)
+                runs[method].append(run(strategy, X, y, scenes, X_test, y_test, args, seed))
+        summary = {method: summarise(r) for method, r in runs.items()}
+        summary["ratios"] = {f"{a}/{b}": {
+            "p50": round(summary[a]["decision_p50_ms"] / max(summary[b]["decision_p50_ms"], 1e-9), 3),
+            "p95": round(summary[a]["decision_p95_ms"] / max(summary[b]["decision_p95_ms"], 1e-9), 3),
+            "accuracy": round(summary[a]["accuracy_mean"] - summary[b]["accuracy_mean"], 4)} for a, b in RATIOS}
+        results[name] = summary
+    return {"settings": {k: getattr(args, k) for k in ("repeats", "turns", "budget", "objects", "change_every",
+                                                        "seed")}, "results": results}
+
+
+def main(argv=None) -> int:
+    args = _parse(sys.argv[1:] if argv is None else argv)
+    try:
+        import skactiveml  # noqa: F401
+    except ImportError:
+        print("bench_peers: scikit-activeml is not installed; pip install -e .[peers]", file=sys.stderr)
+        return 2
+    # skactiveml warns each time its GP sees one class only and falls back to class counts, as designed
+    warnings.filterwarnings("ignore", category=UserWarning, module="skactiveml")
+    report = benchmark(args)
+    for name, summary in report["results"].items():
+        print(f"{name}: accuracy mean (std), decision p50 / p95 ms, mean queries label/demo/feature/none")
+        for method in METHODS:
+            s, q = summary[method], summary[method]["queries_mean"]
+            print(f"  {method:17s} {s['accuracy_mean']:.3f} ({s['accuracy_std']:.3f})  "
+                  f"{s['decision_p50_ms']:8.2f} / {s['decision_p95_ms']:8.2f}  "
+                  f"{q['label']:.1f}/{q['demo']:.1f}/{q['feature']:.1f}/{q['none']:.1f}")
+        for pair, ratio in summary["ratios"].items():
+            print(f"  {pair}: time p50 x{ratio['p50']}, p95 x{ratio['p95']}, accuracy {ratio['accuracy']:+.3f}")
+    if args.json:
+        print(json.dumps(report))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
