@@ -8,7 +8,7 @@ submodule such as ``learning.gp`` does not pull in scikit-learn:
 
 - ``ConceptClassifier``: a scikit-learn classifier of one binary GP per class;
 - ``TeachingLoop``: observe a scene, ``ask`` a ``Query``, ``tell`` the answer;
-- ``apply_answer``: the one place an answer changes a ``LearningState``.
+- ``LearningState.apply`` (also ``apply_answer``): the one place an answer changes the learner.
 """
 
 from importlib import import_module
@@ -23,6 +23,7 @@ _EXPORTS = {
     "apply_answer": "learning.answers",
     "check_answer": "learning.answers",
     "Change": "learning.answers",
+    "DemoRow": "learning.answers",
     "AnswerError": "learning.answers",
     "LearningState": "learning.state",
     "STRATEGY_NAMES": "learning.strategies",

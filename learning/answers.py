@@ -1,22 +1,24 @@
-"""Applying a teacher's answer to the learning state: one place, checked before anything changes.
+"""Teachers' answers in the learner's terms: checking them, and what applying one did.
 
-``apply_answer(state, action, answer)`` takes an answer in the state's own terms
-(concept names, scene object indices, feature indices or names) and returns a
-:class:`Change` saying what it did. Call it *before* ``state.record_turn(action)``:
-the turn's bookkeeping reads what the answer added (a demonstration query that
-added no example marks its concept as absent from the scene).
+``LearningState.apply(action, answer)`` is the one place an answer changes the
+learner; it checks the answer with :func:`check_answer` before anything changes,
+records the turn and returns a :class:`Change`, which ``LearningState.undo``
+takes back. ``apply_answer(state, action, answer)`` is the same call as a function.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from learning.actions import Action
-from learning.concepts import checked_subset
+from learning.concepts import checked_row, checked_subset
 from learning.errors import TeachbotError
-from learning.state import LearningState
+
+if TYPE_CHECKING:
+    from learning.state import Example, LearningState
 
 
 class AnswerError(TeachbotError):
@@ -34,6 +36,15 @@ class Change:
     source: str | None = None
     features: tuple[int, ...] | None = None
     previous_subsets: dict | None = field(default=None, compare=False, repr=False)
+    example: Example | None = field(default=None, compare=False, repr=False)  # the row an "example" added
+
+
+@dataclass(frozen=True)
+class DemoRow:
+    """A demonstration given as a row of feature values rather than a scene index (an object from elsewhere,
+    such as one fetched from the pantry)."""
+
+    x: object
 
 
 def check_answer(state: LearningState, action: Action, answer):
@@ -49,11 +60,16 @@ def check_answer(state: LearningState, action: Action, answer):
             raise AnswerError(f"the answer to a label query is one of the concepts {list(state.concepts)} "
                               f"(or None to skip), got {answer!r}")
         return answer
+    if action.kind == "demo" and isinstance(answer, DemoRow):
+        try:
+            return DemoRow(checked_row(answer.x, len(state.feature_names), f"the demonstration of '{action.concept}'"))
+        except ValueError as error:
+            raise AnswerError(str(error)) from None
     if kind == "demo":
         n = len(state.scene_X)
         if isinstance(answer, (bool, np.bool_)) or not isinstance(answer, (int, np.integer)) or not 0 <= answer < n:
             raise AnswerError(f"the answer to a demonstration query is the index of an object of the current scene "
-                              f"(0..{n - 1}), or None if there is none, got {answer!r}")
+                              f"(0..{n - 1}), a DemoRow, or None if there is none, got {answer!r}")
         return int(answer)
     if kind == "feature":
         return feature_indices(state.feature_names, answer)
@@ -83,23 +99,5 @@ def feature_indices(feature_names, answer) -> np.ndarray:
 
 
 def apply_answer(state: LearningState, action: Action, answer) -> Change:
-    """Learn from ``answer`` to ``action`` (checked first; a bad answer raises AnswerError and changes nothing).
-
-    label: a concept name, the object's row joins the training set; demo: a scene object index (None: the
-    teacher has none to show); feature: feature indices or names; None for no answer (no query: always None).
-    """
-    answer = check_answer(state, action, answer)
-    if action.kind == "none":
-        return Change("none")
-    if answer is None:
-        return Change("absent" if action.kind == "demo" else "skipped",
-                      concept=getattr(action, "concept", None))
-    if action.kind == "label":
-        state.add_example(state.scene_X[action.object_index], answer, "label")
-        return Change("example", concept=answer, object=action.object_index, source="label")
-    if action.kind == "demo":
-        state.add_example(state.scene_X[answer], action.concept, "demo")
-        return Change("example", concept=action.concept, object=answer, source="demo")
-    previous = dict(state.feature_subsets)
-    state.set_feature_subset(answer)
-    return Change("features", features=tuple(int(i) for i in answer), previous_subsets=previous)
+    """``state.apply(action, answer)``: learn from the answer and record the turn (see LearningState.apply)."""
+    return state.apply(action, answer)

@@ -50,7 +50,7 @@ class BinaryGPClassifier:
             return self
         K = rbf_kernel(X, X, self.length_scale_, self.variance)
         self.f_hat_, self.W_sqrt_, self.L_ = self._newton(K, self.targets_)
-        self.grad_ = (self.targets_ + 1) / 2 - _sigmoid(self.f_hat_)  # d log p(y|f) / df at the mode
+        self.grad_ = (self.targets_ + 1) / 2 - sigmoid(self.f_hat_)  # d log p(y|f) / df at the mode
         return self
 
     def _newton(self, K: np.ndarray, t: np.ndarray):
@@ -58,7 +58,7 @@ class BinaryGPClassifier:
         n = len(t)
         f = np.zeros(n)
         for _ in range(self.max_newton_steps):
-            pi = _sigmoid(f)
+            pi = sigmoid(f)
             W = pi * (1 - pi)
             sw = np.sqrt(W)
             B = np.eye(n) + sw[:, None] * K * sw[None, :]
@@ -71,7 +71,7 @@ class BinaryGPClassifier:
                 f = f_new
                 break
             f = f_new
-        pi = _sigmoid(f)
+        pi = sigmoid(f)
         sw = np.sqrt(pi * (1 - pi))
         L = cho_factor(np.eye(n) + sw[:, None] * K * sw[None, :], lower=True)
         return f, sw, L
@@ -90,8 +90,9 @@ class BinaryGPClassifier:
     def predict_proba(self, X: np.ndarray) -> np.ndarray:
         """p(y = 1 | x) by the probit approximation sigma(mu / sqrt(1 + pi var / 8))."""
         mean, var = self.latent(X)
-        return _sigmoid(mean / np.sqrt(1.0 + np.pi * var / 8.0))
+        return sigmoid(mean / np.sqrt(1.0 + np.pi * var / 8.0))
 
 
-def _sigmoid(z: np.ndarray) -> np.ndarray:
+def sigmoid(z: np.ndarray) -> np.ndarray:
+    """The logistic function 1 / (1 + exp(-z)), written with tanh so it never overflows."""
     return 0.5 * (1.0 + np.tanh(0.5 * z))

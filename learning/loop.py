@@ -15,15 +15,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from learning.actions import DEFAULT_COSTS, Action, NoQuery, validate_costs
-from learning.answers import AnswerError, Change, apply_answer, check_answer
+from learning.actions import ACTION_KINDS, DEFAULT_COSTS, Action, NoQuery, validate_costs
+from learning.answers import AnswerError, Change
 from learning.classifier import ConceptClassifier
 from learning.concepts import checked_rows, normalise_rows
 from learning.errors import TeachbotError
 from learning.state import LearningState
 from learning.strategies import Strategy, make_strategy
 
-QUERY_KINDS = ("label", "demo", "feature", "none")
+QUERY_KINDS = ACTION_KINDS
 
 
 class CallOrderError(TeachbotError):
@@ -124,7 +124,7 @@ class TeachingLoop:
         decision = self.strategy.choose(self.state, self.rng)
         action, reason = admissible(self.state, decision.action)
         query = Query(action.kind, getattr(action, "object_index", None),
-                      self._labels.get(getattr(action, "concept", None)), self.state.cost(action),
+                      self._labels.get(action.concept) if action.kind == "demo" else None, self.state.cost(action),
                       reason or decision.explanation)
         self._pending = (action, query)
         return query
@@ -136,15 +136,15 @@ class TeachingLoop:
         if self._pending is None:
             raise CallOrderError("tell came without a question: call ask() first")
         action, query = self._pending
+        state = self.state_or_error()  # a pending question means a state
         internal = self._internal_answer(action, answer)
-        change = apply_answer(self.state, action, internal)
-        self.state.record_turn(action)
-        self._history.append(Turn(self.state.turn - 1, self.state.scene_id, query, answer, change))
+        change = state.apply(action, internal)
+        self._history.append(Turn(state.turn - 1, state.scene_id, query, answer, change))
         self._pending = None
         return change
 
     def _internal_answer(self, action: Action, answer):
-        """The answer in the state's terms (concept names as strings), checked: an AnswerError otherwise."""
+        """The answer in the state's terms (concept names as strings); ``LearningState.apply`` checks the rest."""
         if action.kind == "label" and answer is not None:
             try:
                 name = self._internal.get(_plain(answer))
@@ -154,7 +154,7 @@ class TeachingLoop:
                 raise AnswerError(f"the answer to a label query is one of the concepts {list(self.concepts)} "
                                   f"(or None to skip), got {answer!r}")
             answer = name
-        return check_answer(self.state, action, answer)
+        return answer
 
     # -- the learner --------------------------------------------------------------------
     def predict_proba(self, X) -> np.ndarray:
@@ -173,9 +173,9 @@ class TeachingLoop:
         X, labels = state.training_matrix()
         codes = np.array([self._names.index(label) for label in labels], dtype=int)
         subsets = {self.concepts[self._names.index(c)]: s for c, s in state.feature_subsets.items() if s is not None}
-        classifier = ConceptClassifier(length_scale=state.models.length_scale, variance=state.models.variance)
-        classifier.n_features_in_ = len(self.feature_names)
-        classifier._install(_label_array(self.concepts), state.scaler.copy(), X, codes, subsets)
+        classifier = ConceptClassifier(length_scale=state.length_scale, variance=state.kernel_variance)
+        classifier.n_features_in_ = len(state.feature_names)
+        classifier._install(_label_array(self.concepts), state.scaler, X, codes, subsets)
         return classifier
 
     def state_or_error(self) -> LearningState:
@@ -184,7 +184,7 @@ class TeachingLoop:
         return self.state
 
     def _rows(self, X) -> np.ndarray:
-        n = len(self.feature_names)
+        n = len(self.state_or_error().feature_names)
         if np.ndim(X) == 1 and np.shape(X) == (n,):
             X = np.asarray(X)[None, :]
         return checked_rows(X, n, "rows to predict")

@@ -1,20 +1,31 @@
-"""The learner's state: training set, feature subsets, current scene, budget and clock (thesis §7.3.1)."""
+"""The learner's state (thesis §7.3.1): a small composition of the training set and models, the scene, and the
+budget and clock, each read through read-only views.
+
+Three methods change it: ``observe_scene`` (a new scene), ``apply(action, answer)``
+(one whole turn: the answer is learned and the turn is charged and recorded) and
+``undo(change)`` (the teacher takes an answer back). Each checks everything
+before it changes anything, and a refit that fails puts the old parts back, so
+a bad call raises a ValueError naming what was wrong and leaves the state as it was.
+"""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
+from types import MappingProxyType
 
 import numpy as np
 
 from learning.actions import DEFAULT_COSTS, Action, validate_costs
-from learning.concepts import ConceptModels, FeatureScaler, checked_row, checked_rows, checked_subset
+from learning.answers import AnswerError, Change, DemoRow, check_answer, feature_indices
+from learning.concepts import ConceptModels, FeatureScaler, checked_rows
+from learning.progress import Progress, SceneView, read_only
 
 SOURCES = ("label", "demo")  # how a training example may have been obtained
 
 
 @dataclass(frozen=True)
 class Example:
-    """One labelled instance and how it was obtained ("demo" or "label")."""
+    """One labelled instance (a read-only row) and how it was obtained ("demo" or "label")."""
 
     x: np.ndarray
     concept: str
@@ -23,11 +34,7 @@ class Example:
 
 
 class LearningState:
-    """Everything a strategy may look at; the models are refit after every change.
-
-    Every mutator checks its arguments before it changes anything: a bad call raises a ValueError
-    that names what was wrong and leaves the state exactly as it was.
-    """
+    """Everything a strategy may look at; the models are refit after every change of the training set."""
 
     def __init__(self, concepts, feature_names, budget: float, turns: int, costs: dict | None = None,
                  change_every: int = 1, variance: float = 4.0, length_scale: float | None = None):
@@ -37,121 +44,138 @@ class LearningState:
             raise ValueError(f"budget must be >= 0 and turns >= 1, got budget {budget}, turns {turns}")
         self.concepts = tuple(concepts)
         self.feature_names = tuple(feature_names)
-        self.budget = float(budget)
-        self.turns = int(turns)
-        self.change_every = max(int(change_every), 1)
-        self.costs = validate_costs(costs or DEFAULT_COSTS)
-        self.examples: list[Example] = []
-        self.feature_subsets: dict[str, np.ndarray | None] = {c: None for c in self.concepts}
-        self.feature_query_asked = False
-        self.spent = 0.0
-        self.turn = 0
-        self.history: list[str] = []  # action kind of every finished turn
-        self.scene_X = np.zeros((0, len(self.feature_names)))
-        self.scene_id = -1
-        self.asked_in_scene: set[int] = set()  # label queries asked in this scene
-        self.demonstrated_in_scene: set[int] = set()  # scene objects the teacher showed as demonstrations
-        self.absent_in_scene: set[str] = set()  # concepts the teacher could not show in this scene
-        self._examples_at_last_turn = 0
-        self.last_query_scene_id: int | None = None  # scene of the most recent query (None: never asked)
-        self.version = 0  # bumps whenever the models are refit (what-if caches key on it)
-        self.training_version = 0  # bumps whenever the training set changes
-        self.cache: dict = {}  # what-if engines keep (version, value) entries here
-        self.scaler = FeatureScaler(len(self.feature_names))
-        self.models = ConceptModels(self.concepts, variance=variance, length_scale=length_scale)
+        self._progress = Progress(float(budget), int(turns), max(int(change_every), 1),
+                                  validate_costs(costs or DEFAULT_COSTS))
+        self._scene = SceneView(-1, np.zeros((0, len(self.feature_names))))
+        self._examples: tuple[Example, ...] = ()
+        self._subsets = MappingProxyType({c: None for c in self.concepts})
+        self._scaler = FeatureScaler(len(self.feature_names))
+        self._models = ConceptModels(self.concepts, variance=variance, length_scale=length_scale)
+        self._version = 0  # bumps whenever the models are refit (what-if caches key on it)
+        self._training_version = 0  # bumps whenever the training set changes
+        self.cache: dict = {}  # what-if engines memoise (version, value) entries here; not learning state
         self._scene_P: np.ndarray | None = None
-        self.refit()
+        self._refit()
 
-    # -- the world ------------------------------------------------------------
+    # -- changing the state ---------------------------------------------------------
     def observe_scene(self, scene_id: int, X: np.ndarray) -> None:
         """A new observation of the scene; a changed scene also widens the scaler's pool."""
         X = checked_rows(X, len(self.feature_names), f"scene {scene_id} matrix (objects x features)")
-        if scene_id != self.scene_id:
-            previous = (self.scene_id, self.scene_X, self.asked_in_scene, self.demonstrated_in_scene,
-                        self.absent_in_scene, self.scaler)
-            self.scene_id, self.scene_X = scene_id, X
-            self.asked_in_scene = set()
-            self.demonstrated_in_scene = set()
-            self.absent_in_scene = set()
-            self.scaler = self.scaler.copy()
-            self.scaler.update(X)
-            self._refit_or_restore(lambda: self._restore_scene(previous))
+        if scene_id != self._scene.scene_id:
+            scaler = self._scaler.copy()
+            scaler.update(X)
+            self._commit(scene=SceneView(scene_id, X), scaler=scaler)
 
-    def _restore_scene(self, previous) -> None:
-        (self.scene_id, self.scene_X, self.asked_in_scene, self.demonstrated_in_scene, self.absent_in_scene,
-         self.scaler) = previous
+    def apply(self, action: Action, answer=None) -> Change:
+        """One turn: learn from the teacher's ``answer`` to ``action``, charge its cost and advance the clock.
 
-    # -- answers ----------------------------------------------------------------
-    def add_example(self, x: np.ndarray, concept: str, source: str) -> None:
-        """One more training instance: ``x`` (a row of feature values), its concept, and "label" or "demo"."""
-        if concept not in self.concepts:
-            raise ValueError(f"unknown concept '{concept}'; known: {', '.join(self.concepts)}")
-        if source not in SOURCES:
-            raise ValueError(f"unknown example source '{source}'; accepted: {', '.join(SOURCES)}")
-        x = checked_row(x, len(self.feature_names), f"the example of '{concept}'")
-        shown = self._scene_rows_equal_to(x) if source == "demo" else set()
-        previous = (len(self.examples), set(self.demonstrated_in_scene), self.training_version)
-        self.examples.append(Example(x, concept, source, self.scene_id))
-        self.demonstrated_in_scene.update(shown)
-        self.training_version += 1
-        self._refit_or_restore(lambda: self._restore_examples(*previous))
+        label: a concept name (None: skipped); demo: a scene object index, a :class:`DemoRow` (an object from
+        elsewhere) or None (the teacher has none to show); feature: feature indices and/or names (None: skipped);
+        no query: None. The action and the answer are checked first: an unaffordable or unknown action, or an
+        answer that does not fit it, raises a ValueError and changes nothing.
+        """
+        self.check_action(action)
+        self._progress.check_affordable(action)
+        answer = check_answer(self, action, answer)
+        scene, progress = self._scene, self._progress.after(action, self._scene.scene_id)
+        if action.kind == "label":
+            scene = replace(scene, asked=scene.asked | {int(action.object_index)})
+        if action.kind == "none":
+            self._commit(progress=progress)
+            return Change("none")
+        if answer is None:
+            if action.kind == "demo":
+                scene = replace(scene, absent=scene.absent | {action.concept})
+            self._commit(progress=progress, scene=scene)
+            return Change("absent" if action.kind == "demo" else "skipped", concept=getattr(action, "concept", None))
+        if action.kind == "feature":
+            previous = dict(self._subsets)
+            subset = read_only(answer)
+            self._commit(progress=progress, scene=scene, subsets={c: subset for c in self.concepts})
+            return Change("features", features=tuple(int(i) for i in answer), previous_subsets=previous)
+        if action.kind == "label":
+            concept, obj, source, x = answer, int(action.object_index), "label", scene.X[action.object_index]
+        elif isinstance(answer, DemoRow):
+            concept, obj, source, x = action.concept, None, "demo", answer.x
+        else:
+            concept, obj, source, x = action.concept, answer, "demo", scene.X[answer]
+        example = Example(read_only(x), concept, source, scene.scene_id)
+        if source == "demo":
+            scene = replace(scene, demonstrated=scene.demonstrated | scene.rows_equal_to(example.x))
+        self._commit(progress=progress, scene=scene, examples=self._examples + (example,))
+        return Change("example", concept=concept, object=obj, source=source, example=example)
 
-    def _restore_examples(self, count: int, demonstrated: set[int], training_version: int) -> None:
-        del self.examples[count:]
-        self.demonstrated_in_scene, self.training_version = demonstrated, training_version
+    def undo(self, change: Change) -> None:
+        """Take back what an applied answer taught (its example, or its feature subsets); the turn stays spent."""
+        if change.kind == "features" and change.previous_subsets is not None:
+            self._commit(subsets=change.previous_subsets)
+            return
+        if change.kind != "example":
+            raise AnswerError(f"nothing to take back: a '{change.kind}' answer taught nothing")
+        matches = [i for i, e in enumerate(self._examples) if e is change.example]
+        if not matches:
+            raise AnswerError(f"the {change.concept} example was already taken back")
+        assert change.example is not None, "only a held example matched"
+        examples = self._examples[:matches[-1]] + self._examples[matches[-1] + 1:]
+        scene = self._scene
+        if change.example.source == "demo" and change.example.scene_id == scene.scene_id:
+            still_shown = frozenset().union(*(scene.rows_equal_to(e.x) for e in examples
+                                              if e.source == "demo" and e.scene_id == scene.scene_id))
+            scene = replace(scene, demonstrated=scene.demonstrated & still_shown)
+        self._commit(scene=scene, examples=examples)
 
-    def _refit_or_restore(self, restore) -> None:
-        """Refit; if fitting fails (a bug or a numerical failure), undo the change and refit what was there."""
+    def add_prior(self, X, concepts, features=None) -> None:
+        """What is known before the episode: examples (rows of ``X`` and their concepts, as label answers),
+        which join the scaler's pool like a scene, and optionally every concept's feature indices."""
+        X = checked_rows(X, len(self.feature_names), "prior examples (examples x features)")
+        concepts = [str(c) for c in concepts]
+        unknown = sorted(set(concepts) - set(self.concepts))
+        if len(concepts) != len(X) or unknown:
+            raise ValueError(f"prior examples need one known concept per row ({len(X)} rows, {len(concepts)} "
+                             f"concepts, unknown {unknown}); known: {', '.join(self.concepts)}")
+        scaler = self._scaler.copy()
+        scaler.update(X)
+        subsets = None
+        if features is not None:
+            subset = read_only(feature_indices(self.feature_names, features))
+            subsets = {c: subset for c in self.concepts}
+        added = tuple(Example(read_only(x), c, "label", -1) for x, c in zip(X, concepts))
+        self._commit(scaler=scaler, examples=self._examples + added, subsets=subsets)
+
+    def place_progress(self, **fields) -> None:
+        """Put the budget and clock part-way through an episode (``spent``, ``turn``, ``history``,
+        ``feature_query_asked``, ``last_query_scene_id``): benchmarks and tests draw such states."""
+        self._progress = self._progress.placed(**fields)
+
+    def _commit(self, progress: Progress | None = None, scene: SceneView | None = None, examples=None,
+                subsets=None, scaler: FeatureScaler | None = None) -> None:
+        """Swap in new parts and refit if the models' inputs changed; a failing refit puts the old parts back."""
+        old = (self._progress, self._scene, self._examples, self._subsets, self._scaler, self._training_version)
+        self._progress = progress or self._progress
+        self._scene = scene or self._scene
+        if examples is not None:
+            self._examples = tuple(examples)
+            self._training_version += 1
+        if subsets is not None:
+            self._subsets = MappingProxyType(dict(subsets))
+        self._scaler = scaler or self._scaler
+        if examples is None and subsets is None and scaler is None:
+            if self._scene.X is not old[1].X:
+                self._scene_P = None
+            return
         try:
-            self.refit()
+            self._refit()
         except Exception:
-            restore()
-            self.refit()
+            (self._progress, self._scene, self._examples, self._subsets, self._scaler,
+             self._training_version) = old
+            self._refit()
             raise
 
-    def _scene_rows_equal_to(self, x: np.ndarray) -> set[int]:
-        if x.shape != (len(self.feature_names),) or len(self.scene_X) == 0:
-            return set()
-        return set(np.flatnonzero(np.all(self.scene_X == x, axis=1)).tolist())
-
-    def remove_last_example(self) -> Example | None:
-        """Take back the most recent example (the teacher's "undo")."""
-        if not self.examples:
-            return None
-        example = self.examples.pop()
-        if example.source == "demo" and example.scene_id == self.scene_id:
-            still_shown = {i for e in self.examples if e.source == "demo" and e.scene_id == self.scene_id
-                           for i in self._scene_rows_equal_to(e.x)}
-            self.demonstrated_in_scene &= still_shown
-        self.training_version += 1
-        self.refit()
-        return example
-
-    def set_feature_subset(self, indices) -> None:
-        """Restrict every concept's classifier to the teacher's features from now on."""
-        indices = checked_subset(indices, len(self.feature_names), "feature indices")
-        previous = dict(self.feature_subsets)
-        self.feature_subsets = {c: indices for c in self.concepts}
-        self._refit_or_restore(lambda: setattr(self, "feature_subsets", previous))
-
-    def record_turn(self, action: Action) -> None:
-        """Charge the action's cost and advance the clock."""
-        self.check_action(action)
-        cost = self.cost(action)
-        if cost > self.remaining_budget + 1e-9:
-            raise ValueError(f"{action.kind} query costs {cost} but only {self.remaining_budget} is left")
-        self.spent += cost
-        self.history.append(action.kind)
-        if action.kind == "feature":
-            self.feature_query_asked = True
-        if action.kind == "label":
-            self.asked_in_scene.add(action.object_index)
-        if action.kind == "demo" and len(self.examples) == self._examples_at_last_turn:
-            self.absent_in_scene.add(action.concept)  # asked, but no example came back
-        self._examples_at_last_turn = len(self.examples)
-        if action.kind != "none":
-            self.last_query_scene_id = self.scene_id
-        self.turn += 1
+    def _refit(self) -> None:
+        X, labels = self.training_matrix()
+        self._models.fit(self._scaler.transform(X), labels, dict(self._subsets))
+        self._scene_P = None
+        self._version += 1
 
     def check_action(self, action: Action) -> None:
         """A ValueError unless ``action`` is a known kind that fits this state (object in the scene, known
@@ -169,71 +193,119 @@ class LearningState:
             raise ValueError(f"demonstration query concept {getattr(action, 'concept', None)!r} is not one of "
                              f"{', '.join(self.concepts)}")
 
-    # -- budget -------------------------------------------------------------------
-    def cost(self, action: Action) -> float:
-        kind = getattr(action, "kind", None)
-        if kind not in self.costs:
-            raise ValueError(f"unknown action {action!r}; accepted kinds: {', '.join(self.costs)}")
-        return self.costs[kind]
+    version = property(lambda self: self._version, doc="Bumps whenever the models are refit (caches key on it).")
+    training_version = property(lambda self: self._training_version, doc="Bumps whenever the training set changes.")
 
+    # -- the budget and the clock (read-only) ------------------------------------------
     @property
-    def remaining_budget(self) -> float:
-        return self.budget - self.spent
+    def progress(self) -> Progress:
+        return self._progress
+
+    budget = property(lambda self: self._progress.budget)
+    turns = property(lambda self: self._progress.turns)
+    change_every = property(lambda self: self._progress.change_every)
+    costs = property(lambda self: self._progress.costs)
+    spent = property(lambda self: self._progress.spent)
+    turn = property(lambda self: self._progress.turn, doc="Turns finished so far.")
+    history = property(lambda self: self._progress.history, doc="The action kind of every finished turn.")
+    feature_query_asked = property(lambda self: self._progress.feature_query_asked)
+    last_query_scene_id = property(lambda self: self._progress.last_query_scene_id)
+    remaining_budget = property(lambda self: self._progress.remaining_budget)
+
+    def cost(self, action: Action) -> float:
+        return self._progress.cost(action)
 
     def can_afford(self, action: Action) -> bool:
-        return self.cost(action) <= self.remaining_budget + 1e-9
-
-    # -- interaction history ---------------------------------------------------------
-    @property
-    def labelled_in_scene(self) -> set[int]:
-        """Scene objects whose concept the teacher already gave in this scene (asked or demonstrated)."""
-        return self.asked_in_scene | self.demonstrated_in_scene
+        return self._progress.can_afford(action)
 
     def quiet_run(self) -> int:
         """How many turns in a row, up to now, the learner asked nothing."""
-        run = 0
-        for kind in reversed(self.history):
-            if kind != "none":
-                break
-            run += 1
-        return run
+        return self._progress.quiet_run()
 
-    # -- models -------------------------------------------------------------------
+    # -- the scene (read-only) -----------------------------------------------------------
+    @property
+    def scene(self) -> SceneView:
+        return self._scene
+
+    scene_id = property(lambda self: self._scene.scene_id)
+    scene_X = property(lambda self: self._scene.X, doc="The current scene's rows (read-only).")
+    asked_in_scene = property(lambda self: self._scene.asked, doc="Objects asked about with a label query.")
+    demonstrated_in_scene = property(lambda self: self._scene.demonstrated, doc="Objects the teacher showed.")
+    absent_in_scene = property(lambda self: self._scene.absent, doc="Concepts the teacher could not show here.")
+    labelled_in_scene = property(lambda self: self._scene.labelled,
+                                 doc="Objects whose concept the teacher gave in this scene (asked or shown).")
+
+    # -- the training set and the models (read-only) ----------------------------------------
+    @property
+    def examples(self) -> tuple[Example, ...]:
+        return self._examples
+
+    @property
+    def feature_subsets(self) -> MappingProxyType:
+        """Each concept's feature indices (read-only), None for every feature."""
+        return self._subsets
+
+    @property
+    def scaler(self) -> FeatureScaler:
+        """A copy of the scaler the models' inputs are standardised with."""
+        return self._scaler.copy()
+
+    @property
+    def models(self) -> ConceptModels:
+        """The fitted concept models, to read (the state refits them; nothing else may)."""
+        return self._models
+
+    @property
+    def kernel_variance(self) -> float:
+        return self._models.variance
+
+    @property
+    def length_scale(self) -> float | None:
+        """The fixed RBF length scale, or None (sqrt of the number of features used)."""
+        return self._models.length_scale
+
+    def concept_model(self, concept: str):
+        """The fitted binary GP of ``concept`` (to read)."""
+        return self._models.models_[concept]
+
+    def model_columns(self, concept: str) -> np.ndarray:
+        """The feature columns the model of ``concept`` uses."""
+        return self._models.columns(concept, len(self.feature_names))
+
     def training_matrix(self) -> tuple[np.ndarray, np.ndarray]:
-        if not self.examples:
+        if not self._examples:
             return np.zeros((0, len(self.feature_names))), np.array([], dtype=object)
-        return np.vstack([e.x for e in self.examples]), np.array([e.concept for e in self.examples], dtype=object)
-
-    def refit(self) -> None:
-        X, labels = self.training_matrix()
-        self.models.fit(self.scaler.transform(X), labels, self.feature_subsets)
-        self._scene_P = None
-        self.version += 1
+        return (np.vstack([e.x for e in self._examples]),
+                np.array([e.concept for e in self._examples], dtype=object))
 
     def scaled_training(self) -> tuple[np.ndarray, np.ndarray]:
         """The training rows as the models see them (standardised) and their concept names."""
         X, labels = self.training_matrix()
-        return self.scaler.transform(X), labels
+        return self._scaler.transform(X), labels
 
     def scaled_scene(self) -> np.ndarray:
         """The current scene's rows, standardised like the training rows."""
-        return self.scaler.transform(self.scene_X)
+        return self._scaler.transform(self.scene_X)
 
     def probabilities(self, X: np.ndarray | None = None) -> np.ndarray:
-        """(n, |Y|) p(y|x) for ``X`` (default: the current scene, cached)."""
+        """(n, |Y|) p(y|x) for ``X`` (default: the current scene, cached and read-only)."""
         if X is None:
             if self._scene_P is None:
-                self._scene_P = self.models.predict(self.scaler.transform(self.scene_X))
+                P = self._models.predict(self._scaler.transform(self.scene_X))
+                P.setflags(write=False)
+                self._scene_P = P
             return self._scene_P
-        return self.models.predict(self.scaler.transform(checked_rows(X, len(self.feature_names), "rows to predict")))
+        return self._models.predict(self._scaler.transform(checked_rows(X, len(self.feature_names),
+                                                                         "rows to predict")))
 
     def counts_per_concept(self) -> dict[str, int]:
         """Positive examples of each concept in the training set."""
         counts = {c: 0 for c in self.concepts}
-        for example in self.examples:
+        for example in self._examples:
             counts[example.concept] += 1
         return counts
 
     def predict(self, X: np.ndarray) -> np.ndarray:
         """The most probable concept name for each row."""
         return np.array(self.concepts, dtype=object)[np.argmax(self.probabilities(X), axis=1)]
+

@@ -16,7 +16,7 @@ import numpy as np
 
 from learning.actions import Action, NoQuery
 from learning.evaluation import accuracy
-from learning.state import Example, LearningState
+from learning.state import LearningState
 
 DEFAULT_CONCEPTS = ("main dish", "snack", "fruit", "beverage")
 
@@ -65,18 +65,6 @@ class SyntheticTask:
         return None
 
 
-def apply_answer(state: LearningState, action: Action, answer, X: np.ndarray) -> None:
-    """Update the learner as the dialog manager does."""
-    if answer is None:
-        return
-    if action.kind == "label":
-        state.add_example(X[action.object_index], answer, "label")
-    elif action.kind == "demo":
-        state.add_example(X[answer], action.concept, "demo")
-    elif action.kind == "feature":
-        state.set_feature_subset(answer)
-
-
 @dataclass
 class EpisodeSummary:
     actions: list
@@ -92,15 +80,15 @@ def run_episode(strategy, task: SyntheticTask, rng: np.random.Generator, budget:
     state = LearningState(task.concepts, task.feature_names, budget, turns, costs=costs, change_every=change_every)
     test_X, test_y = task.sample(test_objects, rng)
     actions, explanations = [], []
-    X = truth = None
+    X: np.ndarray  # both set at turn 0, the first scene
+    truth: np.ndarray
     for turn in range(turns):
         if turn % change_every == 0:
             X, truth = task.sample(objects, rng)
             state.observe_scene(turn // change_every, X)
         decision = strategy.choose(state, rng)
         action = decision.action if state.can_afford(decision.action) else NoQuery()
-        apply_answer(state, action, task.answer(action, X, truth, rng), X)
-        state.record_turn(action)
+        state.apply(action, task.answer(action, X, truth, rng))
         actions.append(action)
         explanations.append(decision.explanation)
     return EpisodeSummary(actions, explanations, accuracy(state.predict(test_X), test_y), state.spent)
@@ -115,15 +103,13 @@ def random_state(task: SyntheticTask, n_train: int, n_objects: int, rng: np.rand
     proportions = rng.dirichlet(np.full(len(task.concepts), 2.0))
     X, labels = task.sample(n_train, rng, proportions)
     scene_X, _ = task.sample(n_objects, rng)
-    state.scaler.update(X)
-    state.examples.extend(Example(x, str(label), "label", -1) for x, label in zip(X, labels))
-    state.training_version += 1
-    state.observe_scene(0, scene_X)  # updates the scaler with the scene and refits
+    features = None
     if feature_query_answered:
-        extra = rng.choice(task.n_features, 2, replace=False)
-        state.set_feature_subset(np.union1d(task.informative, extra))
-        state.feature_query_asked = True
-    state.turn = int(rng.integers(0, turns // 2))
-    state.spent = float(rng.uniform(0.0, 0.5)) * budget
-    state.history = [str(k) for k in rng.choice(["label", "demo", "none"], size=state.turn, p=[0.4, 0.2, 0.4])]
+        features = np.union1d(task.informative, rng.choice(task.n_features, 2, replace=False))
+    state.add_prior(X, labels, features)
+    state.observe_scene(0, scene_X)  # updates the scaler with the scene and refits
+    turn = int(rng.integers(0, turns // 2))
+    spent = float(rng.uniform(0.0, 0.5)) * budget
+    history = [str(k) for k in rng.choice(["label", "demo", "none"], size=turn, p=[0.4, 0.2, 0.4])]
+    state.place_progress(turn=turn, spent=spent, history=history, feature_query_asked=feature_query_answered)
     return state

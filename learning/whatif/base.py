@@ -66,8 +66,8 @@ def feature_query_subsets(state, method: str = FEATURE_SELECTION_METHOD,
     return computational_subsets(X, labels, state.concepts, method=method, significance=significance)
 
 
-def cached(state, key: str, version: int, compute):
-    """``compute()`` once per ``version`` of ``state`` (kept in ``state.cache``)."""
+def cached(state, key: str, version: Hashable, compute):
+    """``compute()`` once per ``version`` of ``state`` (any comparable tag; kept in ``state.cache``)."""
     entry = state.cache.get(key)
     if entry is not None and entry[0] == version:
         return entry[1]

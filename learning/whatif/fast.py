@@ -69,8 +69,8 @@ def pair_table(state) -> np.ndarray:
     table = np.empty((n_objects, n_concepts, n_objects, n_concepts))
     kernels = {}  # classifiers on the same features share their kernels (they share the training rows)
     for c, concept in enumerate(state.concepts):
-        model = state.models.models_[concept]
-        columns = state.models.columns(concept, scene.shape[1])
+        model = state.concept_model(concept)
+        columns = state.model_columns(concept)
         key = (tuple(columns), model.length_scale_)
         if key not in kernels:
             kernels[key] = scene_kernels(model.X_train_, scene[:, columns], model.length_scale_, model.variance)
@@ -104,7 +104,7 @@ def feature_outcomes(state) -> np.ndarray:
     for key, probabilities in distinct.items():
         subset = np.array(key)
         for c, concept in enumerate(concepts):
-            columns = state.models.columns(concept, X.shape[1])
+            columns = state.model_columns(concept)
             if len(columns) == len(subset) and np.array_equal(columns, subset):
                 probabilities[:, c] = current[:, c]  # the answer changes nothing for this classifier
             else:
@@ -126,14 +126,14 @@ def feature_outcomes(state) -> np.ndarray:
 
 
 def _length_scale(state, subset: np.ndarray) -> float:
-    return state.models.length_scale or default_length_scale(len(subset))
+    return state.length_scale or default_length_scale(len(subset))
 
 
 def _low_rank_features(state, subset, X, scene) -> np.ndarray | None:
     """Phi with K ~ Phi Phi^T over the training rows then the scene rows, if the subset's kernel allows."""
     if len(subset) > LOW_RANK_MAX_FEATURES or (len(subset) == LOW_RANK_MAX_FEATURES and len(X) < THREE_FEATURES_FROM):
         return None
-    variance = state.models.variance
+    variance = state.kernel_variance
     points = np.vstack([X[:, subset], scene[:, subset]])
     return pivoted_cholesky(points, _length_scale(state, subset), variance, LOW_RANK_TOLERANCE * variance,
                             len(X) // LOW_RANK_MAX_FRACTION)
@@ -157,14 +157,14 @@ def _fit_low_rank(state, rows, features, n_train, labels, distinct) -> None:
             Phi = pad_columns([features[key] for key in keys])[[keys.index(key) for key, _ in members]]
             train, scene = Phi[:, :n_train], Phi[:, n_train:]
         z, C = fit_weight_space(train, targets)
-        fitted = predict_weight_space(scene, state.models.variance, z, C)
+        fitted = predict_weight_space(scene, state.kernel_variance, z, C)
         for (key, c), probabilities in zip(members, fitted):
             distinct[key][:, c] = probabilities
 
 
 def _fit_dense(state, rows, X, labels, scene, distinct) -> None:
     """Refit every (subset, classifier) row exactly, all in one batched Newton (``fit_modes``)."""
-    concepts, variance = state.concepts, state.models.variance
+    concepts, variance = state.concepts, state.kernel_variance
     keys = list(dict.fromkeys(key for key, _ in rows))
     kernels, cross = [], []
     for key in keys:
@@ -173,7 +173,7 @@ def _fit_dense(state, rows, X, labels, scene, distinct) -> None:
         cross.append(rbf_kernel(X[:, subset], scene[:, subset], _length_scale(state, subset), variance))
     kernel_of_row = np.array([keys.index(key) for key, _ in rows])
     targets = np.array([np.where(labels == concepts[c], 1.0, -1.0) for _, c in rows])
-    start = np.array([state.models.models_[concepts[c]].f_hat_ for _, c in rows])  # current latent modes
+    start = np.array([state.concept_model(concepts[c]).f_hat_ for _, c in rows])  # current latent modes
     sw, factors, gradient = fit_modes(np.stack(kernels), targets, kernel_of_row, start)
     fitted = predict_from_modes(np.stack(cross), variance, sw, factors, gradient, kernel_of_row)
     for (key, c), probabilities in zip(rows, fitted):

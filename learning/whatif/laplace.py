@@ -27,14 +27,10 @@ import numpy as np
 from scipy.linalg import solve_triangular
 from scipy.linalg.lapack import spotrf, spotrs, strtrs
 
-from learning.gp import BinaryGPClassifier, rbf_kernel
+from learning.gp import BinaryGPClassifier, rbf_kernel, sigmoid
 
 MIN_VARIANCE = 1e-12
 MIN_SITE_SCALE = 1e-6  # W^1/2 below this: too small to divide by
-
-
-def sigmoid(z: np.ndarray) -> np.ndarray:
-    return 0.5 * (1.0 + np.tanh(0.5 * z))
 
 
 def probit_probability(mean: np.ndarray, variance: np.ndarray) -> np.ndarray:
@@ -121,6 +117,7 @@ def one_site_probabilities(posterior: ScenePosterior, max_steps: int = 50, toler
     shrink = w / (1.0 + w * site_variance)  # (2, m)
     new_mean = mean[None, None, :] + cov[None, :, :] * shift[:, :, None]
     if posterior.cross is not None:
+        assert posterior.mode is not None and posterior.W is not None, "cross, mode and W are set together"
         moved = posterior.mode[None, None, :] + posterior.cross.T[None, :, :] * shift[:, :, None]  # [t, j, n]
         residual = sigmoid(posterior.mode) - sigmoid(moved) + posterior.W * (moved - posterior.mode)
         # Cov(scene, train) r for every (t, j), as one matrix product
@@ -134,6 +131,24 @@ def one_site_probabilities(posterior: ScenePosterior, max_steps: int = 50, toler
 def _log_likelihood(targets: np.ndarray, f: np.ndarray) -> np.ndarray:
     """sum_i log sigma(t_i f_i) per row."""
     return -np.logaddexp(0.0, -targets * f).sum(axis=-1)
+
+
+def _backtrack(x, step, f, f_step, psi, objective, halvings: int = 30):
+    """Newton steps with backtracking per row: halve a row's step until its objective does not fall.
+
+    ``x`` moves by ``step`` and the latent ``f`` by ``f_step`` (the same step seen through the kernel);
+    ``objective(x, f)`` is the Laplace objective Psi per row. Returns the scales and the accepted
+    (x, f, Psi).
+    """
+    scale = np.ones(len(x))
+    for _ in range(halvings):
+        trial_x, trial_f = x + scale[:, None] * step, f + scale[:, None] * f_step
+        trial_psi = objective(trial_x, trial_f)
+        worse = trial_psi < psi - 1e-12 * np.abs(psi)
+        if not np.any(worse):
+            break
+        scale[worse] /= 2.0
+    return scale, trial_x, trial_f, trial_psi
 
 
 def fit_modes(kernels: np.ndarray, targets: np.ndarray, kernel_of_row: np.ndarray | None = None,
@@ -205,14 +220,9 @@ def fit_modes(kernels: np.ndarray, targets: np.ndarray, kernel_of_row: np.ndarra
         factorise(active[change[active] > refactor_above])
         step = apply_inverse(positive[active] - sigmoid(f[active]) - a[active], active)
         f_step = times_K(step, active)
-        scale = np.ones(len(active))
-        for _ in range(30):  # backtrack rows whose objective fell (rare: far from the mode)
-            trial_a, trial_f = a[active] + scale[:, None] * step, f[active] + scale[:, None] * f_step
-            trial_psi = _log_likelihood(targets[active], trial_f) - 0.5 * np.einsum("bi,bi->b", trial_a, trial_f)
-            worse = trial_psi < psi[active] - 1e-12 * np.abs(psi[active])
-            if not np.any(worse):
-                break
-            scale[worse] /= 2.0
+        _, trial_a, trial_f, trial_psi = _backtrack(  # rows whose objective fell (rare: far from the mode)
+            a[active], step, f[active], f_step, psi[active],
+            lambda x, f_x, t=targets[active]: _log_likelihood(t, f_x) - 0.5 * np.einsum("bi,bi->b", x, f_x))
         change[active] = np.max(np.abs(trial_f - f[active]), axis=1, initial=0.0)
         a[active], f[active], psi[active] = trial_a, trial_f, trial_psi
     factorise(np.flatnonzero(np.max(np.abs(f - factored_at), axis=1, initial=0.0) > final_refactor_above))
@@ -307,14 +317,9 @@ def fit_weight_space(Phi: np.ndarray, targets: np.ndarray, tolerance: float = 1e
             C[active] = identity + np.matmul(rows32.transpose(0, 2, 1) * weights, rows32)
         step = np.linalg.solve(C[active], gradient[:, :, None])[:, :, 0]
         step_f = step @ Phi.T if shared else np.matmul(rows, step[:, :, None])[:, :, 0]
-        scale = np.ones(len(active))
-        for _ in range(30):
-            trial_z, trial_f = z[active] + scale[:, None] * step, f[active] + scale[:, None] * step_f
-            trial_psi = _log_likelihood(targets[active], trial_f) - 0.5 * np.einsum("br,br->b", trial_z, trial_z)
-            worse = trial_psi < psi[active] - 1e-12 * np.abs(psi[active])
-            if not np.any(worse):
-                break
-            scale[worse] /= 2.0
+        scale, trial_z, trial_f, trial_psi = _backtrack(
+            z[active], step, f[active], step_f, psi[active],
+            lambda x, f_x, t=targets[active]: _log_likelihood(t, f_x) - 0.5 * np.einsum("br,br->b", x, x))
         moved = np.max(np.abs(scale[:, None] * step_f), axis=1, initial=0.0)
         z[active], f[active], psi[active] = trial_z, trial_f, trial_psi
         active = active[moved >= tolerance]

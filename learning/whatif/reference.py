@@ -30,7 +30,7 @@ class ReferenceEngine(WhatIfEngine):
             if extra_row is not None:
                 rows = np.vstack([X, extra_row[None, :]])
                 names = np.append(labels, np.array([extra_label], dtype=object))
-            models = ConceptModels(concepts, variance=state.models.variance, length_scale=state.models.length_scale)
+            models = ConceptModels(concepts, variance=state.kernel_variance, length_scale=state.length_scale)
             return models.fit(rows, names, subsets).predict(scene)
 
         current = state.feature_subsets

@@ -26,7 +26,7 @@ def small_state(seed=0, **kwargs):
 
 def test_candidates_come_in_a_fixed_order_with_no_query_last():
     state = small_state()
-    state.asked_in_scene.add(1)
+    state.apply(LabelQuery(1), None)  # asked about object 1 (the teacher skipped)
     actions = candidate_actions(state)
     assert actions == (*(DemoQuery(c) for c in TASK.concepts), LabelQuery(0), LabelQuery(2), LabelQuery(3),
                        FeatureQuery(), NoQuery())
@@ -34,23 +34,23 @@ def test_candidates_come_in_a_fixed_order_with_no_query_last():
 
 def test_a_demonstrated_object_is_not_asked_about_again():
     state = small_state()
-    state.add_example(state.scene_X[2], TASK.concepts[1], "demo")
+    change = state.apply(DemoQuery(TASK.concepts[1]), 2)
     assert LabelQuery(2) not in candidate_actions(state)
-    state.remove_last_example()
+    state.undo(change)
     assert LabelQuery(2) in candidate_actions(state)
 
 
 def test_only_affordable_queries_are_candidates():
     state = small_state()
-    state.spent = state.budget - 1  # one unit left: label queries only
+    state.place_progress(spent=state.budget - 1)  # one unit left: label queries only
     assert {a.kind for a in candidate_actions(state)} == {"label", "none"}
-    state.spent = state.budget
+    state.place_progress(spent=state.budget)
     assert candidate_actions(state) == (NoQuery(),)
 
 
 def test_expected_features_follow_each_query_into_the_next_turn():
     state = small_state(1)
-    state.history = ["none", "none"]
+    state.place_progress(history=["none", "none"])
     candidates = expected_decision_features(state)
     current = state_features(state)
     np.testing.assert_allclose(candidates.current, current)
@@ -65,7 +65,7 @@ def test_expected_features_follow_each_query_into_the_next_turn():
 
 def test_class_uniformity_is_expected_over_the_answers():
     state = small_state(2, n_train=0)
-    state.add_example(state.scene_X[0], TASK.concepts[0], "label")
+    state.apply(LabelQuery(0), TASK.concepts[0])
     candidates = expected_decision_features(state)
     demo = candidates.expected[candidates.actions.index(DemoQuery(TASK.concepts[1]))]
     assert demo[CDU] == 0.0  # counts (1, 1, 0, 0): the smallest class is still empty
@@ -76,7 +76,7 @@ def test_class_uniformity_is_expected_over_the_answers():
 @given(st.integers(0, 10_000), st.floats(0.0, 8.0), st.booleans())
 def test_every_expected_feature_is_in_the_unit_interval(seed, budget, answered):
     state = small_state(seed, n_train=seed % 9, budget=budget, feature_query_answered=answered)
-    state.spent = min(state.spent, budget)
+    state.place_progress(spent=min(state.spent, budget))
     candidates = expected_decision_features(state)
     assert np.all(candidates.expected >= 0.0) and np.all(candidates.expected <= 1.0)
     assert all(state.can_afford(action) for action in candidates.actions)

@@ -94,12 +94,12 @@ def test_every_feature_stays_in_the_unit_interval(P, counts, spent, budget, turn
 def test_state_features_read_the_learning_state():
     task = SyntheticTask(n_features=8, n_informative=3)
     state = random_state(task, 12, 6, np.random.default_rng(0), budget=20, turns=40)
-    state.history = ["label", "none", "none"]
+    state.place_progress(history=["label", "none", "none"])
     phi = state_features(state)
     assert np.all((phi >= 0) & (phi <= 1))
     clock = state_clock(state)
     assert clock.quiet_run == 2 and clock.window == state.change_every
     assert phi[FEATURE_NAMES.index("non_query_time")] == pytest.approx(2 / state.change_every)
-    state.record_turn(DemoQuery(task.concepts[0]))
-    state.record_turn(NoQuery())
+    state.apply(DemoQuery(task.concepts[0]), None)
+    state.apply(NoQuery())
     assert state.quiet_run() == 1

@@ -28,34 +28,34 @@ def state_with_scene(rng, budget=10, turns=10):
 def test_labelled_examples_make_the_models_accurate(rng):
     state, X, labels = state_with_scene(rng)
     for index in range(0, len(X), 2):
-        state.add_example(X[index], labels[index], "label")
+        state.apply(LabelQuery(index), labels[index])
     X_test, y_test = blobs(rng, 20)
     assert accuracy(state.predict(X_test), y_test) > 0.9
 
 
 def test_budget_is_charged_and_never_exceeded(rng):
     state, _, _ = state_with_scene(rng, budget=3)
-    state.record_turn(DemoQuery("a"))
+    state.apply(DemoQuery("a"), None)
     assert state.remaining_budget == 1 and state.can_afford(LabelQuery(0))
     assert not state.can_afford(DemoQuery("b"))
     with pytest.raises(ValueError, match="costs 2"):
-        state.record_turn(DemoQuery("b"))
-    state.record_turn(NoQuery())
-    assert state.spent == 2 and state.history == ["demo", "none"]
+        state.apply(DemoQuery("b"), 0)
+    state.apply(NoQuery())
+    assert state.spent == 2 and state.history == ("demo", "none") and len(state.examples) == 0
 
 
 def test_passive_asks_for_the_least_represented_concept(rng):
     state, X, labels = state_with_scene(rng)
-    state.add_example(X[0], "a", "demo")
-    state.add_example(X[7], "b", "demo")
+    state.apply(DemoQuery("a"), 0)
+    state.apply(DemoQuery("b"), 7)
     decision = make_strategy("passive").choose(state, rng)
     assert decision.action == DemoQuery("c")
 
 
 def test_active_asks_about_the_most_uncertain_object(rng):
     state, X, labels = state_with_scene(rng)
-    state.add_example(X[0], "a", "label")
-    state.add_example(X[6], "b", "label")
+    state.apply(LabelQuery(0), "a")
+    state.apply(LabelQuery(6), "b")
     decision = make_strategy("active").choose(state, rng)
     scores = entropy(state.probabilities())
     assert decision.action == LabelQuery(int(np.argmax(scores)))
@@ -69,7 +69,7 @@ def test_active_does_not_repeat_an_object_in_the_same_scene(rng):
         action = strategy.choose(state, rng).action
         assert action.object_index not in asked
         asked.add(action.object_index)
-        state.record_turn(action)
+        state.apply(action, None)
     assert strategy.choose(state, rng).action == NoQuery()
 
 
@@ -91,8 +91,9 @@ def test_unknown_strategy_and_bad_costs_are_clear_errors():
 
 def test_undo_removes_the_last_example(rng):
     state, X, _ = state_with_scene(rng)
-    state.add_example(X[0], "a", "label")
+    state.apply(LabelQuery(0), "a")
     before = state.probabilities().copy()
-    state.add_example(X[1], "b", "label")
-    assert state.remove_last_example().concept == "b"
-    assert np.allclose(state.probabilities(), before)
+    change = state.apply(LabelQuery(1), "b")
+    state.undo(change)
+    assert change.concept == "b" and [e.concept for e in state.examples] == ["a"]
+    assert np.allclose(state.probabilities(), before) and state.turn == 2  # the turn stays spent

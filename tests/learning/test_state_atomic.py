@@ -1,10 +1,12 @@
-"""LearningState validates before it mutates (issue 13, case 10): a bad call leaves it exactly as it was."""
+"""LearningState validates before it mutates (issue 13, case 10; issue 14): a bad call leaves it exactly as it was,
+its parts are read-only, and apply/undo are the only ways an answer changes it."""
 
 import numpy as np
 import pytest
 
 import learning.state as state_module
 from learning.actions import DemoQuery, FeatureQuery, LabelQuery, NoQuery
+from learning.answers import Change, DemoRow
 from learning.concepts import ConceptModels, FeatureScaler, checked_subset
 from learning.state import LearningState
 
@@ -14,13 +16,12 @@ PROBE = np.array([[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [0.0, 4.0, 1.0], [2.0, 2.0, 
 
 
 def _state(rng) -> LearningState:
-    state = LearningState(CONCEPTS, FEATURES, budget=6, turns=10)
+    state = LearningState(CONCEPTS, FEATURES, budget=10, turns=20)
     centres = np.array([[0, 0, 0], [4, 0, 0], [0, 4, 0]], dtype=float)
     X = np.vstack([c + rng.normal(0, 0.5, (3, 3)) for c in centres])
     state.observe_scene(0, X)
-    state.add_example(X[0], "a", "label")
-    state.add_example(X[3], "b", "demo")
-    state.record_turn(LabelQuery(0))
+    state.apply(LabelQuery(0), "a")
+    state.apply(DemoQuery("b"), 3)
     return state
 
 
@@ -31,9 +32,9 @@ def _snapshot(state: LearningState) -> dict:
         "predictions": state.probabilities(PROBE).round(12).tolist(),
         "scene": (state.scene_id, state.scene_X.tolist()),
         "versions": (state.version, state.training_version),
-        "sets": (set(state.asked_in_scene), set(state.demonstrated_in_scene), set(state.absent_in_scene)),
+        "sets": (state.asked_in_scene, state.demonstrated_in_scene, state.absent_in_scene),
         "subsets": {c: None if s is None else s.tolist() for c, s in state.feature_subsets.items()},
-        "clock": (state.spent, state.turn, list(state.history), state.feature_query_asked),
+        "progress": state.progress,
     }
 
 
@@ -43,21 +44,31 @@ BAD_CALLS = {
     "scene with NaN": lambda s: s.observe_scene(1, np.array([[1.0, np.nan, 0.0], [0.0, 1.0, 2.0]])),
     "scene with infinity": lambda s: s.observe_scene(1, np.array([[1.0, np.inf, 0.0]])),
     "scene of words": lambda s: s.observe_scene(1, [["x", "y", "z"]]),
-    "example of the wrong length": lambda s: s.add_example(np.zeros(4), "a", "label"),
-    "example as a matrix": lambda s: s.add_example(np.zeros((2, 3)), "a", "label"),
-    "example with NaN": lambda s: s.add_example(np.array([0.0, np.nan, 1.0]), "a", "label"),
-    "example of an unknown concept": lambda s: s.add_example(np.zeros(3), "z", "label"),
-    "example from an unknown source": lambda s: s.add_example(np.zeros(3), "a", "guess"),
-    "no feature indices": lambda s: s.set_feature_subset([]),
-    "feature index out of range": lambda s: s.set_feature_subset([0, 3]),
-    "negative feature index": lambda s: s.set_feature_subset([-1]),
-    "fractional feature index": lambda s: s.set_feature_subset([0.5, 1]),
-    "feature names instead of indices": lambda s: s.set_feature_subset(["f1"]),
-    "boolean feature mask": lambda s: s.set_feature_subset([True, False, True]),
-    "unaffordable turn": lambda s: [s.record_turn(DemoQuery("a")) for _ in range(3)],
-    "unknown action kind": lambda s: s.record_turn("ask nicely"),
-    "label query outside the scene": lambda s: s.record_turn(LabelQuery(9)),
-    "demonstration of an unknown concept": lambda s: s.record_turn(DemoQuery("z")),
+    "demonstrated row of the wrong length": lambda s: s.apply(DemoQuery("a"), DemoRow(np.zeros(4))),
+    "demonstrated row as a matrix": lambda s: s.apply(DemoQuery("a"), DemoRow(np.zeros((2, 3)))),
+    "demonstrated row with NaN": lambda s: s.apply(DemoQuery("a"), DemoRow([0.0, np.nan, 1.0])),
+    "demonstrated row of words": lambda s: s.apply(DemoQuery("a"), DemoRow(["x", "y", "z"])),
+    "label of an unknown concept": lambda s: s.apply(LabelQuery(1), "z"),
+    "demonstration outside the scene": lambda s: s.apply(DemoQuery("a"), 9),
+    "demonstration as a boolean": lambda s: s.apply(DemoQuery("a"), True),
+    "no feature indices": lambda s: s.apply(FeatureQuery(), []),
+    "feature index out of range": lambda s: s.apply(FeatureQuery(), [0, 3]),
+    "negative feature index": lambda s: s.apply(FeatureQuery(), [-1]),
+    "fractional feature index": lambda s: s.apply(FeatureQuery(), [0.5, 1]),
+    "unknown feature name": lambda s: s.apply(FeatureQuery(), ["f1", "f9"]),
+    "boolean feature mask": lambda s: s.apply(FeatureQuery(), [True, False, True]),
+    "an answer after no query": lambda s: s.apply(NoQuery(), 0),
+    "unaffordable turn": lambda s: [s.apply(DemoQuery("a"), 1) for _ in range(4)],
+    "unknown action kind": lambda s: s.apply("ask nicely"),
+    "label query outside the scene": lambda s: s.apply(LabelQuery(9), "a"),
+    "demonstration of an unknown concept": lambda s: s.apply(DemoQuery("z"), None),
+    "undo of an answer that taught nothing": lambda s: s.undo(Change("skipped")),
+    "undo of an example never added": lambda s: s.undo(Change("example", concept="a")),
+    "progress beyond the budget": lambda s: s.place_progress(spent=11),
+    "progress of an unknown field": lambda s: s.place_progress(budget=3),
+    "history of unknown kinds": lambda s: s.place_progress(history=["label", "chat"]),
+    "prior examples without concepts": lambda s: s.add_prior(np.zeros((2, 3)), ["a"]),
+    "prior examples of unknown concepts": lambda s: s.add_prior(np.zeros((1, 3)), ["zebra"]),
 }
 
 
@@ -68,25 +79,25 @@ def test_a_bad_call_raises_a_clear_error_and_changes_nothing(name, rng):
     with pytest.raises(ValueError) as raised:
         BAD_CALLS[name](state)
     assert "Traceback" not in str(raised.value) and len(str(raised.value)) > 20
-    if name != "unaffordable turn":  # two demonstrations fit the budget before the third is refused
+    if name != "unaffordable turn":  # three demonstrations fit the budget before the fourth is refused
         assert _snapshot(state) == before
     else:
-        assert _snapshot(state)["examples"] == before["examples"] and state.spent == 5 and state.turn == 3
+        assert len(state.examples) == 5 and state.spent == 9 and state.turn == 5
     # the next good calls still work
-    state.add_example(np.array([0.1, 3.9, 0.2]), "c", "label")
+    state.place_progress(spent=0)
     state.observe_scene(2, PROBE)
-    state.set_feature_subset([0, 1])
-    state.record_turn(LabelQuery(1))
+    state.apply(LabelQuery(2), "c")
+    state.apply(FeatureQuery(), [0, 1])
     assert state.predict(PROBE[:2]).tolist() == ["a", "b"]
 
 
 def test_the_issue_sequence_wrong_row_then_nan_scene_keeps_the_state_usable(rng):
     state = _state(rng)
     with pytest.raises(ValueError, match="3 feature values"):
-        state.add_example(np.zeros(5), "a", "label")
+        state.apply(DemoQuery("a"), DemoRow(np.zeros(5)))
     with pytest.raises(ValueError, match="NaN or infinite"):
         state.observe_scene(1, np.array([[np.nan, 0.0, 0.0]]))
-    state.add_example(np.array([0.0, 4.0, 0.0]), "c", "demo")  # used to fail inside scipy with the bad example kept
+    state.apply(DemoQuery("c"), DemoRow([0.0, 4.0, 0.0]))  # used to fail inside scipy with the bad example kept
     assert np.all(np.isfinite(state.scaler.mean)) and len(state.examples) == 3
 
 
@@ -94,15 +105,18 @@ def test_the_messages_name_what_was_wrong(rng):
     state = _state(rng)
     with pytest.raises(ValueError, match=r"row 0, column 1"):
         state.observe_scene(1, np.array([[1.0, np.nan, 0.0]]))
-    with pytest.raises(ValueError, match="'guess'.*label, demo"):
-        state.add_example(np.zeros(3), "a", "guess")
+    with pytest.raises(ValueError, match=r"'z'"):
+        state.apply(LabelQuery(0), "z")
     with pytest.raises(ValueError, match=r"within 0\.\.2, got 7"):
-        state.set_feature_subset([1, 7])
+        state.apply(FeatureQuery(), [1, 7])
     with pytest.raises(ValueError, match="accepted kinds"):
-        state.record_turn(object())
+        state.apply(object())
+    with pytest.raises(ValueError, match="costs 2 but only 1 is left"):
+        state.place_progress(spent=9)
+        state.apply(DemoQuery("a"), 0)
 
 
-def test_a_refit_that_fails_undoes_the_change(rng, monkeypatch):
+def test_a_refit_that_fails_undoes_the_change_and_charges_nothing(rng, monkeypatch):
     state = _state(rng)
     before = _snapshot(state)
     real_fit = ConceptModels.fit
@@ -116,21 +130,80 @@ def test_a_refit_that_fails_undoes_the_change(rng, monkeypatch):
 
     monkeypatch.setattr(state_module.ConceptModels, "fit", failing_once)
     with pytest.raises(np.linalg.LinAlgError):
-        state.add_example(np.array([1.0, 1.0, 1.0]), "a", "label")
+        state.apply(LabelQuery(1), "a")
     after = _snapshot(state)
     assert after["examples"] == before["examples"] and after["predictions"] == before["predictions"]
     assert after["versions"][1] == before["versions"][1]
+    assert after["progress"] == before["progress"] and after["sets"] == before["sets"]
 
 
 def test_good_calls_still_accept_what_callers_pass(rng):
     state = _state(rng)
-    state.set_feature_subset(np.array([2, 0, 2], dtype=np.int64))
-    assert state.feature_subsets["a"].tolist() == [0, 2]
-    state.add_example([1, 2, 3], "b", "label")  # a list of ints is a row
-    state.record_turn(FeatureQuery())
-    state.record_turn(NoQuery())
-    state.record_turn(LabelQuery(np.int64(2)))
-    assert state.turn == 4
+    change = state.apply(FeatureQuery(), np.array([2, 0, 2], dtype=np.int64))
+    assert state.feature_subsets["a"].tolist() == [0, 2] and change.features == (0, 2)
+    assert state.apply(DemoQuery("b"), DemoRow([1, 2, 3])).object is None  # a list of ints is a row
+    state.apply(NoQuery())
+    state.apply(LabelQuery(np.int64(2)), None)
+    state.apply(DemoQuery("c"), np.int64(6))
+    assert state.turn == 7 and state.history[-5:] == ("feature", "demo", "none", "label", "demo")
+
+
+def test_the_parts_are_read_only(rng):
+    state = _state(rng)
+    for name in ("spent", "turn", "history", "scene_X", "examples", "feature_subsets", "absent_in_scene",
+                 "feature_query_asked", "budget", "scene_id"):
+        with pytest.raises(AttributeError):
+            setattr(state, name, getattr(state, name))
+    state.apply(FeatureQuery(), [0, 2])
+    for array in (state.scene_X, state.examples[0].x, state.feature_subsets["a"], state.probabilities()):
+        with pytest.raises(ValueError, match="read-only"):
+            array[0] = 1.0
+    with pytest.raises(TypeError):
+        state.feature_subsets["a"] = None
+    state.scaler.update(PROBE)  # a copy: the state's scaler is unchanged
+    assert _snapshot(state)["scaler"][2] == 9
+
+
+def test_apply_records_the_turn_in_the_right_order(rng):
+    state = _state(rng)
+    assert state.progress.spent == 3 and state.history == ("label", "demo") and state.turn == 2
+    assert "b" not in state.absent_in_scene and state.demonstrated_in_scene == {3}  # shown, so not absent
+    assert state.asked_in_scene == {0} and state.last_query_scene_id == 0
+    assert state.apply(DemoQuery("c"), None).kind == "absent" and state.absent_in_scene == {"c"}
+    assert state.apply(LabelQuery(4), None).kind == "skipped" and 4 in state.asked_in_scene
+    state.observe_scene(1, PROBE)  # a new scene forgets what was said about the old one
+    assert state.absent_in_scene == state.asked_in_scene == state.demonstrated_in_scene == frozenset()
+    assert state.apply(NoQuery()).kind == "none" and state.quiet_run() == 1 and state.last_query_scene_id == 0
+
+
+def test_undo_takes_back_the_answer_but_not_the_turn(rng):
+    state = _state(rng)
+    before = _snapshot(state)
+    shown = state.apply(DemoQuery("c"), 6)
+    features = state.apply(FeatureQuery(), ["f2"])
+    assert 6 in state.demonstrated_in_scene and state.feature_subsets["a"].tolist() == [1]
+    state.undo(features)
+    state.undo(shown)
+    after = _snapshot(state)
+    for key in ("examples", "predictions", "subsets", "scaler"):
+        assert after[key] == before[key], key
+    assert 6 not in state.demonstrated_in_scene and 3 in state.demonstrated_in_scene
+    assert state.turn == 4 and state.spent == 7 and state.feature_query_asked
+    with pytest.raises(ValueError, match="already taken back"):
+        state.undo(shown)
+    fetched = state.apply(DemoQuery("a"), DemoRow(state.scene_X[1]))  # a row equal to object 1 marks it shown
+    assert fetched.object is None and 1 in state.demonstrated_in_scene
+    state.undo(fetched)
+    assert 1 not in state.demonstrated_in_scene
+
+
+def test_prior_examples_join_the_scaler_and_may_set_features():
+    state = LearningState(CONCEPTS, FEATURES, budget=4, turns=4)
+    state.add_prior(PROBE[:3], ["a", "b", "c"], features=["f1", 1])
+    assert len(state.examples) == 3 and state.scaler._count == 3 and state.turn == 0 and state.spent == 0
+    assert all(s.tolist() == [0, 1] for s in state.feature_subsets.values())
+    state.place_progress(turn=2, history=["none", "label"], feature_query_asked=True)
+    assert state.quiet_run() == 0 and state.feature_query_asked and state.turn == 2
 
 
 def test_scaler_and_models_check_caller_arrays_before_changing():

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from sklearn.datasets import load_iris
 
-from learning import AnswerError, CallOrderError, LearningState, TeachingLoop, apply_answer
+from learning import AnswerError, CallOrderError, DemoRow, LearningState, TeachingLoop, apply_answer
 from learning.actions import Decision, DemoQuery, FeatureQuery, LabelQuery, NoQuery
 from learning.strategies import STRATEGY_NAMES, Strategy
 
@@ -224,16 +224,69 @@ def test_the_same_seed_gives_the_same_questions():
     assert run(4) != run(5)
 
 
-def test_apply_answer_works_on_a_bare_state_before_record_turn():
+def test_apply_answer_works_on_a_bare_state_and_records_the_turn():
     state = LearningState(("a", "b"), NAMES, budget=10, turns=5)
     state.observe_scene(0, X_IRIS[:6])
-    before = (len(state.examples), state.version)
+    before = (len(state.examples), state.version, state.turn)
     with pytest.raises(AnswerError, match="one of the concepts"):
         apply_answer(state, LabelQuery(2), "c")
-    assert (len(state.examples), state.version) == before
+    assert (len(state.examples), state.version, state.turn) == before
     change = apply_answer(state, DemoQuery("b"), 4)
-    state.record_turn(DemoQuery("b"))
-    assert change.kind == "example" and "b" not in state.absent_in_scene
+    assert change.kind == "example" and "b" not in state.absent_in_scene and state.spent == 2
     assert np.array_equal(state.examples[-1].x, X_IRIS[4]) and state.examples[-1].source == "demo"
     change = apply_answer(state, FeatureQuery(), "petal width")
     assert change.features == (3,) and change.previous_subsets == {"a": None, "b": None}
+
+
+BAD_ANSWERS = {
+    "label": [("mango", "one of the concepts"), (7, "one of the concepts"), ([0], "one of the concepts")],
+    "demo": [(12, r"\(0\.\.11\)"), (-1, r"\(0\.\.11\)"), (True, "index of an object"), ("2", "index of an object"),
+             (DemoRow(np.zeros(3)), "4 feature values"), (DemoRow([np.nan] * 4), "NaN or infinite")],
+    "feature": [(["petal"], "unknown feature 'petal'"), ([4], "within 0..3"), ([], "at least one"),
+                ([0.5], "whole-number")],
+    "none": [(0, "only answer is None"), ("petal width", "only answer is None")],
+}
+
+
+def all_kinds_strategy():
+    return Scripted(LabelQuery(0), DemoQuery("1"), FeatureQuery(), DemoQuery("2"), LabelQuery(1), DemoQuery("0"),
+                    NoQuery())
+
+
+@pytest.mark.parametrize("strategy", [*STRATEGY_NAMES, "every kind"])
+def test_every_strategy_meets_every_answer_and_every_error_without_changing_the_state(strategy):
+    """Each turn: every wrong answer to the pending question (and every call out of turn) is refused and changes
+    nothing; then the turn is answered in turn well, with None, or (demonstrations) with a row from elsewhere."""
+    rng = np.random.default_rng(7)
+    loop = TeachingLoop([0, 1, 2], strategy=all_kinds_strategy() if strategy == "every kind" else strategy,
+                        budget=14, turns=9, change_every=3, seed=2, feature_names=NAMES)
+    changes, truth = set(), None
+    while not loop.done:
+        if loop.scene_due:
+            X, truth = scene(rng)
+            loop.observe(X)
+        query = loop.ask()
+        refused(loop, loop.ask, CallOrderError, "ask came twice")
+        refused(loop, lambda X=X: loop.observe(X), CallOrderError, "waits for its answer")
+        for answer, message in BAD_ANSWERS[query.kind]:
+            refused(loop, lambda answer=answer: loop.tell(answer), AnswerError, message)
+        before = loop.budget_left
+        style = loop.turn % 3
+        if query.kind == "demo" and style == 2:  # shown from elsewhere: a row of the concept not in the scene
+            answer = DemoRow(X_IRIS[int(np.flatnonzero(Y_IRIS == query.concept)[-1])])
+        else:
+            answer = None if style == 1 else oracle(query, truth)
+        change = loop.tell(answer)
+        changes.add((query.kind, change.kind, isinstance(answer, DemoRow)))
+        assert loop.budget_left == pytest.approx(before - query.cost)  # every answered turn is charged once
+        if change.kind == "example":
+            assert loop.state.examples[-1] is change.example
+            assert (change.object is None) == isinstance(answer, DemoRow)
+        if query.kind == "demo" and answer is None:
+            assert change.kind == "absent" and query.concept in (int(c) for c in loop.state.absent_in_scene)
+    refused(loop, lambda: loop.tell(None), CallOrderError, "without a question")
+    assert loop.turn == 9 and len(loop.state.history) == 9 and loop.budget_left >= 0
+    if strategy == "every kind":
+        assert changes >= {("label", "example", False), ("label", "skipped", False), ("demo", "example", False),
+                           ("demo", "absent", False), ("demo", "example", True), ("feature", "features", False),
+                           ("none", "none", False)}

@@ -67,8 +67,8 @@ def test_a_demo_answer_and_a_label_answer_give_the_same_state(seed, engine, answ
 def test_permuting_the_scene_only_permutes_label_indices(seed, order, engine):
     state = small_state(seed, n_train=1 + seed % 9, n_objects=5)
     shuffled = small_state(seed, n_train=1 + seed % 9, n_objects=5)
-    shuffled.scene_X = state.scene_X[list(order)]
-    shuffled.refit()
+    shuffled.observe_scene(1, state.scene_X[list(order)])  # both see the same rows again: the same scaling
+    state.observe_scene(1, state.scene_X)
     before = expected_decision_features(state, engine)
     after = expected_decision_features(shuffled, engine)
     position = {new: old for old, new in enumerate(order)}  # shuffled object k was object order[k]
