@@ -38,7 +38,7 @@ def timed_scene(world: World, rng: np.random.Generator):
         except HiddenObjectError:
             continue
         return scene, time.perf_counter() - wall, time.process_time() - cpu
-    raise RuntimeError("three samples in a row hid an object from the camera")
+    raise HiddenObjectError("three samples in a row hid an object from the camera")
 
 
 def _summary(values_m: np.ndarray) -> dict[str, float]:

@@ -25,6 +25,7 @@ import numpy as np
 from bullet_world.catalogue import DatasetPlan, load_task
 from bullet_world.datafiles import DATA_DIR, cache_dir, resolve, write_atomically
 from bullet_world.world import World
+from learning.errors import SettingsError
 
 DATASET_VERSION = 1
 GENERATOR_MODULES = ("bodies", "camera", "catalogue", "datafiles", "datasets", "features", "kitchen", "meshes",
@@ -87,7 +88,7 @@ def _stratified(pool: Pool, size: int, concepts, rng: np.random.Generator) -> Po
     for concept, count in zip(concepts, quota):
         available = np.flatnonzero(pool.concepts == concept)
         if len(available) < count:
-            raise RuntimeError(f"only {len(available)} observations of '{concept}' for a pool that needs {count}")
+            raise SettingsError(f"only {len(available)} observations of '{concept}' for a pool that needs {count}")
         rows.append(rng.choice(available, count, replace=False))
     return pool.take(np.sort(np.concatenate(rows)))
 

@@ -15,6 +15,11 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from bullet_world.kitchen import Kitchen, Location
+from learning.errors import SceneError
+
+
+class PlacementError(SceneError):
+    """The objects do not fit the kitchen's object region (or their locations) without overlap."""
 
 BATCH = 64        # candidate poses tried at once for one object (more in later batches)
 BATCHES = 10      # batches per object before the whole scene starts again
@@ -117,7 +122,7 @@ def _region_pool(kitchen: Kitchen) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         spots = rng.uniform(low, high, (POOL_SIZE * 4, 2))
         spots = spots[kitchen.in_object_region(spots)][:POOL_SIZE]
         if len(spots) == 0:
-            raise RuntimeError(f"kitchen '{kitchen.name}': the [object_region] holds no spot within reach")
+            raise PlacementError(f"kitchen '{kitchen.name}': the [object_region] holds no spot within reach")
         weights = np.full(len(spots), 1.0 / len(spots))
         if kitchen.focus is not None:
             gathered = np.exp(-0.5 * np.sum((spots - kitchen.focus) ** 2, axis=1) / kitchen.focus_spread ** 2)
@@ -195,8 +200,8 @@ def place(footprints: list[Footprint], kitchen: Kitchen, rng: np.random.Generato
         if done == n:
             return centres, yaws
     area = sum(fp.area for fp in footprints)
-    raise RuntimeError(f"cannot place {n} objects ({area:.2f} m^2 of footprint) in kitchen '{kitchen.name}' "
-                       f"without overlap; use fewer objects or a kitchen with a larger [object_region]")
+    raise PlacementError(f"cannot place {n} objects ({area:.2f} m^2 of footprint) in kitchen '{kitchen.name}' "
+                         f"without overlap; use fewer objects or a kitchen with a larger [object_region]")
 
 
 def footprint_rows(footprints: list[Footprint], centres: np.ndarray, yaws: np.ndarray) -> np.ndarray:

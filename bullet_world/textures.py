@@ -19,6 +19,7 @@ import cv2
 import numpy as np
 
 from bullet_world.datafiles import cache_dir, write_atomically
+from learning.errors import OutputPathError
 
 TEXTURE_VERSION = 2
 WIDTH, HEIGHT = 256, 128
@@ -146,7 +147,7 @@ def _texture_file(pattern: str, base: tuple, inner: tuple, seed: int, cache: str
         image = texture_image(pattern, base, inner, seed)
         ok, encoded = cv2.imencode(".png", cv2.cvtColor(image, cv2.COLOR_RGB2BGR))
         if not ok:
-            raise RuntimeError(f"could not encode texture {path.name}")
+            raise OutputPathError(f"could not encode texture {path.name}")
         write_atomically(path, encoded.tobytes())
     return str(path)
 

@@ -25,14 +25,15 @@ from bullet_world.features import (
     robot_feature_catalogue,
 )
 from bullet_world.perception import measure_objects
-from bullet_world.placement import Footprint, footprint_rows, place
+from bullet_world.placement import Footprint, PlacementError, footprint_rows, place
 from bullet_world.scene import Scene, SceneTruth
 from bullet_world.sensors import AmbientNoise, light_reading, weigh
+from learning.errors import SceneError, SettingsError
 
 PLACEMENT_RETRIES = 6   # new samples when one does not fit on the counter or hides an object from the camera
 
 
-class HiddenObjectError(RuntimeError):
+class HiddenObjectError(SceneError):
     """An object in the world is not visible to the camera."""
 
 
@@ -61,9 +62,9 @@ class World:
         self.kinds: tuple[ObjectKind, ...] = self.task.kinds_in(self.kitchen.name)
         if objects_per_scene is not None:
             if not len(self.task.concepts) <= objects_per_scene <= self.task.max_objects_per_scene:
-                raise ValueError(f"objects_per_scene must be between {len(self.task.concepts)} and "
-                                 f"{self.task.max_objects_per_scene} for task '{self.task.name}', "
-                                 f"got {objects_per_scene}")
+                raise SettingsError(f"objects_per_scene must be between {len(self.task.concepts)} and "
+                                    f"{self.task.max_objects_per_scene} for task '{self.task.name}', "
+                                    f"got {objects_per_scene}")
             self.task = replace(self.task, objects_per_scene=int(objects_per_scene))
         self.client = p.connect(p.GUI if gui else p.DIRECT)
         p.setGravity(0, 0, -9.81, physicsClientId=self.client)
@@ -190,7 +191,7 @@ class World:
             try:
                 centres, yaws = place(footprints, self.kitchen, rng, locations, avoid=self._reserved())
                 break
-            except RuntimeError:
+            except PlacementError:
                 if attempt == PLACEMENT_RETRIES - 1:
                     raise
         for kind, draw, xy, yaw in zip(kinds, draws, centres, yaws):
@@ -228,7 +229,7 @@ class World:
             locations = [self._location_of(self.objects[i].kind, draws[i]["state"]) for i in changing]
             try:
                 centres, yaws = place(footprints, self.kitchen, rng, locations, fixed=fixed, avoid=self._reserved())
-            except RuntimeError:  # the locations are full: the changed objects stand wherever there is room
+            except PlacementError:  # the locations are full: the changed objects stand wherever there is room
                 centres, yaws = place(footprints, self.kitchen, rng, None, fixed=fixed)
             for i, xy, yaw in zip(changing, centres, yaws):
                 old = self.objects[i]

@@ -17,6 +17,7 @@ import sys
 import dialog.commands
 from dialog.interrupts import CleanSignals, exit_code
 from dialog.threads import one_blas_thread
+from learning.errors import TeachbotError
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -49,7 +50,7 @@ def main(argv: list[str] | None = None) -> int:
             command = "teachbot" if args is None else f"teachbot {args.command}"
             if signals.signum is not None:
                 return _report_signal(command, signals.signum)
-            if isinstance(error, (ValueError, RuntimeError, FileNotFoundError)):
+            if isinstance(error, TeachbotError):  # bad input: one line; anything else is a bug and shows its traceback
                 print(f"{command}: {error}", file=sys.stderr)
                 return 2
             raise

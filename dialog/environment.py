@@ -2,22 +2,26 @@
 
 ``SimulatedKitchen`` is the real one (PyBullet world + Panda arm); tests may pass
 any object with ``concepts``, ``feature_names``, ``next_scene``, ``point_at``
-and ``test_set``. The rest is optional and looked up with ``getattr``:
-``locations`` (for descriptions), ``scene_picture`` (numbered pictures),
-``can_fetch``/``fetch`` (pantry), ``relevant_features`` (for scripted teachers).
+and ``test_set`` (:class:`Environment`). The optional abilities are Protocols,
+checked once when the manager is made: :class:`SupportsLocations` and
+:class:`SupportsViewpoint` (for descriptions), :class:`SupportsPictures` (numbered scene
+pictures), :class:`SupportsFetch` (the pantry), :class:`KnowsRelevantFeatures`
+(for scripted teachers) and :class:`HasTestScenes` (the task's test-set size).
 """
 
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Protocol
+from typing import Protocol, runtime_checkable
 
 import numpy as np
 
 from bullet_world import Scene, World
+from bullet_world.annotate import TeacherPicture, location_corners
 from bullet_world.pantry import Spot, free_spots, glimpse, object_poses, replacement_spots, restore_poses
+from bullet_world.viewpoint import Viewpoint
 from bullet_world.world import HiddenObjectError
-from dialog.pictures import annotate_scene, project_points, save_picture
+from dialog.pictures import annotate_scene, save_picture
 from robot import Arm
 from robot.gestures import point_at
 
@@ -39,6 +43,56 @@ class Environment(Protocol):
     def test_set(self, n_scenes: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]: ...
 
 
+@runtime_checkable
+class SupportsLocations(Protocol):
+    """Named kitchen locations, for descriptions such as "on the stove"."""
+
+    @property
+    def locations(self) -> dict: ...
+
+
+@runtime_checkable
+class SupportsViewpoint(Protocol):
+    """The teacher's viewpoint, for descriptions such as "at the back left"."""
+
+    @property
+    def viewpoint(self) -> Viewpoint: ...
+
+
+@runtime_checkable
+class SupportsPictures(Protocol):
+    """Numbered pictures of a scene for the teacher."""
+
+    def scene_picture(self, scene: Scene, path: str | Path, highlight: int | None = None) -> Path: ...
+
+
+@runtime_checkable
+class SupportsFetch(Protocol):
+    """The pantry: fetch an example of a concept the teacher says is not in the scene."""
+
+    def can_fetch(self, concept: str) -> bool: ...
+
+    def fetch(self, scene: Scene, concept: str, rng: np.random.Generator) -> dict | None: ...
+
+
+@runtime_checkable
+class KnowsRelevantFeatures(Protocol):
+    """The task's features that matter (ground truth, for scripted teachers only)."""
+
+    @property
+    def relevant_features(self) -> tuple[str, ...] | None: ...
+
+
+@runtime_checkable
+class HasTestScenes(Protocol):
+    """How many held-out scenes the task's test set has."""
+
+    test_scenes: int
+
+
+DEFAULT_TEST_SCENES = 4  # for an environment that does not say
+
+
 class SimulatedKitchen:
     """A PyBullet kitchen with the Panda: real rendering, perception, pointing and fetching."""
 
@@ -50,12 +104,17 @@ class SimulatedKitchen:
         self.feature_names = self.world.feature_names
         self.test_scenes = self.world.task.test_scenes
         self.pictures = pictures
-        self._scene_image = None  # (scene id, rgb, pixel position of every object)
+        self._scene_image = None  # (scene id, turned rgb, pixels of every object, location corner pixels)
         self._arm_out = False  # the arm pointed since the last scene: rest it before the world is observed again
 
     @property
     def locations(self) -> dict:
         return dict(self.world.kitchen.locations)
+
+    @property
+    def viewpoint(self) -> Viewpoint:
+        """The teacher's: across the counter from the robot (left, right, front and back in words and pictures)."""
+        return Viewpoint.of_kitchen(self.world.kitchen)
 
     @property
     def relevant_features(self) -> tuple[str, ...] | None:
@@ -102,16 +161,17 @@ class SimulatedKitchen:
         camera, images = self.world.camera, getattr(self.world, "images", None)
         if images is None or self.world.scene is not scene:  # the frame the scene was measured from, if kept
             images = camera.render(self.world.client, self.world.lighting)
-        pixels = project_points(scene.positions, images.view_matrix, images.projection_matrix,
-                                camera.width, camera.height)
-        self._scene_image = (scene.scene_id, images.rgb, pixels)
+        view = TeacherPicture(images, self.viewpoint)
+        regions = {name: view.pixels(location_corners(location)) for name, location in self.locations.items()}
+        self._scene_image = (scene.scene_id, view.rgb, view.pixels(scene.positions), regions)
 
     def scene_picture(self, scene: Scene, path: str | Path, highlight: int | None = None) -> Path:
-        """Write the scene's camera image with every object's number (``highlight`` ringed) to ``path``."""
+        """Write the scene's camera image as the teacher sees it (the robot at the top), with every object's
+        number (``highlight`` ringed) and the kitchen's locations, to ``path``."""
         if self._scene_image is None or self._scene_image[0] != scene.scene_id:
             self._capture(scene)
-        _, rgb, pixels = self._scene_image
-        return save_picture(path, annotate_scene(rgb, pixels, range(1, len(pixels) + 1), highlight))
+        _, rgb, pixels, regions = self._scene_image
+        return save_picture(path, annotate_scene(rgb, pixels, range(1, len(pixels) + 1), highlight, regions))
 
     # -- the pantry -----------------------------------------------------------------
     def can_fetch(self, concept: str) -> bool:

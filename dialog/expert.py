@@ -18,19 +18,21 @@ transcript (``<name>.jsonl``).
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Protocol
 
 import numpy as np
 
 from dialog.clock import VirtualClock
-from dialog.manager import DialogManager, EpisodeConfig, EpisodeResult, episode_generators
+from dialog.manager import DialogManager, EpisodeResult, episode_generators
+from dialog.settings import EpisodeSettings
 from dialog.teachers import ScriptedTeacher
 from dialog.transcript import TranscriptWriter
-from learning.actions import DEFAULT_COSTS, Action, Decision
+from learning.actions import Action, Decision
 from learning.decision.candidates import CandidateFeatures, expected_decision_features
 from learning.decision.features import FEATURE_NAMES
+from learning.errors import OutputPathError, SettingsError
 from learning.irl.demonstrations import DecisionTurn, QuestioningEpisode, save_episodes
 from learning.state import LearningState
 from learning.strategies.base import Strategy
@@ -111,24 +113,22 @@ class ExpertStrategy(Strategy):
         return QuestioningEpisode(FEATURE_NAMES, tuple(self.turns), name, metadata)
 
 
-@dataclass
-class ExpertSettings:
-    """One expert episode; the defaults are the thesis's training condition (§7.4.1)."""
+@dataclass(frozen=True)
+class ExpertSettings(EpisodeSettings):
+    """One expert episode; the defaults are the thesis's training condition (§7.4.1), and a scripted teacher
+    with these mislabel and don't-know rates answers."""
 
     task: str = "prepare-lunch"
-    kitchen: str = "kitchen-1"
     budget: float = 15.0
-    turns: int = 30
     change_every: int = 10
-    seed: int = 0
-    costs: dict = field(default_factory=lambda: dict(DEFAULT_COSTS))
     mislabel_rate: float = 0.0
     dont_know_rate: float = 0.0
-    fetch_from_pantry: bool = True
 
-    def config(self) -> EpisodeConfig:
-        return EpisodeConfig(turns=self.turns, budget=self.budget, change_every=self.change_every, seed=self.seed,
-                             costs=dict(self.costs), fetch_from_pantry=self.fetch_from_pantry)
+    def __post_init__(self):
+        super().__post_init__()
+        for name, value in (("mislabel_rate", self.mislabel_rate), ("dont_know_rate", self.dont_know_rate)):
+            if not (isinstance(value, (int, float)) and not isinstance(value, bool) and 0 <= value <= 1):
+                raise SettingsError(f"{name} must be between 0 and 1, got {value!r}")
 
     def name(self, expert: str) -> str:
         return f"{expert}-{self.task}-seed{self.seed}"
@@ -153,11 +153,11 @@ def output_paths(out_dir: str | Path, name: str) -> tuple[Path, Path]:
     """(demonstration .json, transcript .jsonl) in ``out_dir``; refuses to overwrite either."""
     out_dir = Path(out_dir)
     if out_dir.exists() and not out_dir.is_dir():
-        raise ValueError(f"--out {out_dir} is a file; give a directory for the demonstration and transcript")
+        raise OutputPathError(f"--out {out_dir} is a file; give a directory for the demonstration and transcript")
     demonstration, transcript = out_dir / f"{name}.json", out_dir / f"{name}.jsonl"
     for path in (demonstration, transcript):
         if path.exists():
-            raise ValueError(f"{path} already exists; choose another --out directory or --seed")
+            raise OutputPathError(f"{path} already exists; choose another --out directory or --seed")
     return demonstration, transcript
 
 

@@ -22,13 +22,16 @@ import numpy as np
 from dialog import records as checks
 from dialog.clock import VirtualClock
 from dialog.conversation import Outcome, converse
-from dialog.environment import Environment
+from dialog.environment import DEFAULT_TEST_SCENES, Environment, HasTestScenes, SupportsFetch
 from dialog.parsing import AnswerParser
 from dialog.questions import Prompt, Questioner, acknowledgement, question_text
 from dialog.records import action_record, answer_record
 from dialog.replay import replay_turn
+from dialog.settings import DEFAULTS, check_allocation
+from dialog.teachers import as_teacher
 from dialog.transcript import TranscriptWriter
-from learning.actions import DEFAULT_COSTS, Action, NoQuery
+from learning.actions import Action, NoQuery
+from learning.answers import DemoRow
 from learning.evaluation import accuracy
 from learning.state import LearningState
 from learning.strategies import Strategy
@@ -36,35 +39,31 @@ from learning.strategies import Strategy
 __all__ = ["DialogManager", "EpisodeConfig", "EpisodeResult", "episode_generators", "question_text"]
 
 STREAMS = ("scenes", "test", "strategy", "teacher", "pantry")
+OBSERVER_EVENTS = ("on_scene", "on_question", "on_answer", "on_turn")
 
 
 @dataclass
 class EpisodeConfig:
-    """One episode's allocation: T turns, budget B, a scene change every r turns.
+    """One episode's allocation for the manager: T turns, budget B, a scene change every r turns.
+
+    The defaults are :data:`dialog.settings.DEFAULTS`; ``EpisodeSettings.config()`` makes one.
 
     realtime: seconds per turn (None: turn-based); a late answer counts as none.
     pictures: folder for numbered scene pictures (None: no pictures).
     fetch_from_pantry: fetch an example the teacher says is absent, where the task allows.
     """
 
-    turns: int = 30
-    budget: float = 40.0
-    change_every: int = 5
-    seed: int = 0
-    costs: dict = field(default_factory=lambda: dict(DEFAULT_COSTS))
-    realtime: float | None = None
+    turns: int = DEFAULTS.turns
+    budget: float = DEFAULTS.budget
+    change_every: int = DEFAULTS.change_every
+    seed: int = DEFAULTS.seed
+    costs: dict = field(default_factory=lambda: dict(DEFAULTS.costs))
+    realtime: float | None = DEFAULTS.realtime
     pictures: str | None = None
-    fetch_from_pantry: bool = True
+    fetch_from_pantry: bool = DEFAULTS.fetch_from_pantry
 
     def __post_init__(self):
-        if self.turns < 1:
-            raise ValueError(f"turns must be at least 1, got {self.turns}")
-        if self.budget < 0:
-            raise ValueError(f"budget must be zero or more, got {self.budget}")
-        if self.change_every < 1:
-            raise ValueError(f"change-every must be at least 1 turn, got {self.change_every}")
-        if self.realtime is not None and not self.realtime > 0:
-            raise ValueError(f"realtime must be a positive number of seconds per turn, got {self.realtime}")
+        check_allocation(self.turns, self.budget, self.change_every, self.realtime)
 
 
 @dataclass
@@ -90,19 +89,24 @@ def episode_generators(seed: int) -> dict[str, np.random.Generator]:
 class DialogManager:
     """Runs one episode of the loop with any environment, teacher and strategy.
 
-    Observers may define ``on_scene(scene)``, ``on_question(action, text, scene)``,
-    ``on_answer(action, outcome, scene)`` and ``on_turn(record, scene)``.
+    Observers may define any of ``on_scene(scene)``, ``on_question(action, text, scene)``,
+    ``on_answer(action, outcome, scene)`` and ``on_turn(record, scene)``. The teacher and the environment's
+    optional abilities (``dialog.environment``: SupportsFetch, HasTestScenes) are checked once, here.
     """
 
     def __init__(self, environment: Environment, teacher, strategy: Strategy, config: EpisodeConfig,
                  transcript: TranscriptWriter, rngs: dict[str, np.random.Generator], say=print,
                  observers: tuple = (), clock=None, parser: AnswerParser | None = None, session: dict | None = None):
-        self.env, self.teacher, self.strategy = environment, teacher, strategy
+        self.env, self.teacher, self.strategy = environment, as_teacher(teacher), strategy
         self.config, self.transcript, self.say = config, transcript, say
         self.rngs = dict(rngs)
         if "pantry" not in self.rngs:
             self.rngs["pantry"] = episode_generators(config.seed)["pantry"]
         self.observers = tuple(observers)
+        self._handlers = {event: tuple(getattr(o, event) for o in self.observers if callable(getattr(o, event, None)))
+                          for event in OBSERVER_EVENTS}
+        self.can_fetch = isinstance(environment, SupportsFetch)
+        self.test_scenes = environment.test_scenes if isinstance(environment, HasTestScenes) else DEFAULT_TEST_SCENES
         self.clock = clock or VirtualClock()
         self.parser = parser or AnswerParser(environment.concepts)
         self.session = dict(session or {})
@@ -128,7 +132,7 @@ class DialogManager:
     def begin(self) -> None:
         """Draw the held-out test set and write the session header (once)."""
         if self._test is None:
-            self._test = self.env.test_set(getattr(self.env, "test_scenes", 4), self.rngs["test"])
+            self._test = self.env.test_set(self.test_scenes, self.rngs["test"])
         if not self.transcript.has_content:
             self.transcript.write_header(self.header())
 
@@ -249,7 +253,8 @@ class DialogManager:
         return record
 
     def _close_turn(self, record: dict, action: Action, outcome: Outcome) -> dict:
-        self.state.record_turn(action)
+        if self.state.turn == self.turn:  # nothing applied this turn (no question was asked): record it as such
+            self.state.apply(action, None)
         test_X, test_y = self._test
         record.update({
             "answer": answer_record(outcome, action, self.state.feature_names),
@@ -281,9 +286,7 @@ class DialogManager:
         return outcome, undone
 
     def teacher_tell(self, text: str) -> None:
-        tell = getattr(self.teacher, "tell", None)
-        if tell is not None:
-            tell(text)
+        self.teacher.tell(text)
 
     def prompt_for(self, action: Action, explanation: str, number: int, start: float, pictures: bool = True) -> Prompt:
         """The question for ``action`` with its details (table, picture, feature tree)."""
@@ -292,52 +295,44 @@ class DialogManager:
 
     # -- answers -------------------------------------------------------------------------
     def _apply(self, action: Action, outcome: Outcome, scene, replaying: bool = False) -> dict:
-        """Learn from the outcome; returns extra transcript fields (a pantry fetch)."""
-        state, extra = self.state, {}
-        if outcome.kind == "answer" and action.kind == "label":
-            state.add_example(scene.X[action.object_index], outcome.value, "label")
-            self._undo_stack.append((self.turn + 1, f"number {action.object_index + 1} is {outcome.value}",
-                                     "example"))
-        elif outcome.kind == "answer" and action.kind == "demo":
-            state.add_example(scene.X[outcome.value], action.concept, "demo")
-            self._undo_stack.append((self.turn + 1, f"number {outcome.value + 1} is {action.concept}", "example"))
-        elif outcome.kind == "absent" and action.kind == "demo" and self._may_fetch(action.concept):
-            extra.update(self._fetch(action.concept, scene))
-        elif outcome.kind == "answer" and action.kind == "feature":
-            previous = dict(state.feature_subsets)
-            state.set_feature_subset(list(outcome.value))
-            self._undo_stack.append((self.turn + 1, f"the choice of {len(outcome.value)} features", "features",
-                                     previous))
+        """Learn from the outcome and record the turn (``LearningState.apply``); returns extra transcript
+        fields (a pantry fetch)."""
+        if outcome.kind == "absent" and action.kind == "demo" and self._may_fetch(action.concept):
+            extra, change = self._fetch(action, scene)
+        else:
+            extra, change = {}, self.state.apply(action, outcome.value if outcome.kind == "answer" else None)
+        if change.kind == "example" and change.object is None:
+            self._undo_stack.append((self.turn + 1, f"the {change.concept} from the pantry", change))
+        elif change.kind == "example":
+            self._undo_stack.append((self.turn + 1, f"number {change.object + 1} is {change.concept}", change))
+        elif change.kind == "features":
+            self._undo_stack.append((self.turn + 1, f"the choice of {len(change.features)} features", change))
         return extra
 
-    def _fetch(self, concept: str, scene) -> dict:
-        """Fetch an example from the pantry; a fetch that fails is told in the dialog, never raised."""
-        fetched = self.env.fetch(scene, concept, self.rngs["pantry"]) or {}
+    def _fetch(self, action: Action, scene) -> tuple[dict, object]:
+        """Fetch an example from the pantry and apply it as the demonstration (or, failing that, apply "none
+        here"); a fetch that fails is told in the dialog, never raised. Returns the extra fields and the change."""
+        fetched = self.env.fetch(scene, action.concept, self.rngs["pantry"]) or {}
         self.clock.advance(fetched.get("sim_seconds", 0.0))
         reason = fetched.get("reason", "the pantry had none")
         if fetched.get("x") is not None:
             try:
-                self.state.add_example(fetched["x"], concept, "demo")
+                change = self.state.apply(action, DemoRow(fetched["x"]))
             except ValueError as error:  # the learner refuses the observation; its state is unchanged
                 reason = f"my measurements of it were unusable ({error})"
             else:
-                self._undo_stack.append((self.turn + 1, f"the {concept} from the pantry", "example"))
-                return {"fetched": {key: fetched[key] for key in ("kind", "position", "replaced") if key in fetched}}
-        return {"fetch_failed": {"kind": fetched.get("kind"), "reason": reason}}
+                kept = {key: fetched[key] for key in ("kind", "position", "replaced") if key in fetched}
+                return {"fetched": kept}, change
+        return {"fetch_failed": {"kind": fetched.get("kind"), "reason": reason}}, self.state.apply(action, None)
 
     def _may_fetch(self, concept: str) -> bool:
-        can = getattr(self.env, "can_fetch", None)
-        return bool(self.config.fetch_from_pantry and can is not None and can(concept))
+        return bool(self.config.fetch_from_pantry and self.can_fetch and self.env.can_fetch(concept))
 
     def _undo(self) -> int:
         """Take back the latest learned answer; returns its turn."""
-        entry = self._undo_stack.pop()
-        if entry[2] == "example":
-            self.state.remove_last_example()
-        else:
-            self.state.feature_subsets = dict(entry[3])
-            self.state.refit()
-        return entry[0]
+        turn, _, change = self._undo_stack.pop()
+        self.state.undo(change)
+        return turn
 
     def model_summary(self) -> dict:
         subsets = [s for s in self.state.feature_subsets.values() if s is not None]
@@ -351,7 +346,5 @@ class DialogManager:
 
     def _notify(self, event: str, *payload) -> None:
         """Tell observers (a viewer, a progress display) what happened; they may not change the episode."""
-        for observer in self.observers:
-            handler = getattr(observer, event, None)
-            if handler is not None:
-                handler(*payload)
+        for handler in self._handlers[event]:
+            handler(*payload)

@@ -15,6 +15,7 @@ import math
 import numpy as np
 
 from dialog.conversation import Outcome
+from dialog.describe import OLD_WORLD_VIEWPOINT, SceneDescriber
 from dialog.questions import question_text
 from learning.actions import Action, DemoQuery, FeatureQuery, LabelQuery, NoQuery
 from learning.errors import TranscriptError
@@ -42,8 +43,8 @@ def action_from_record(record: dict) -> Action:
         return FeatureQuery()
     if kind == "none":
         return NoQuery()
-    raise ValueError(f"unreadable action {record!r}; accepted: {{'kind': 'label', 'object': N}}, "
-                     "{'kind': 'demo', 'concept': NAME}, {'kind': 'feature'} or {'kind': 'none'}")
+    raise TranscriptError(f"unreadable action {record!r}; accepted: {{'kind': 'label', 'object': N}}, "
+                          "{'kind': 'demo', 'concept': NAME}, {'kind': 'feature'} or {'kind': 'none'}")
 
 
 def _parsed(outcome: Outcome, action: Action, feature_names) -> object:
@@ -73,7 +74,8 @@ def outcome_from_record(record: dict, action: Action, feature_names) -> Outcome:
     if action.kind == "none":
         return Outcome("none")
     if kind not in ANSWER_KINDS:
-        raise ValueError(f"turn {record.get('turn')}: answer kind '{kind}' is not one of {', '.join(ANSWER_KINDS)}")
+        raise TranscriptError(f"turn {record.get('turn')}: answer kind '{kind}' is not one of "
+                              f"{', '.join(ANSWER_KINDS)}")
     parsed = answer.get("parsed")
     value = None
     if kind == "answer":
@@ -82,7 +84,7 @@ def outcome_from_record(record: dict, action: Action, feature_names) -> Outcome:
         elif action.kind == "feature":
             unknown = [name for name in parsed if name not in feature_names]
             if unknown:
-                raise ValueError(f"turn {record.get('turn')}: features {unknown} are not among this session's")
+                raise TranscriptError(f"turn {record.get('turn')}: features {unknown} are not among this session's")
             value = tuple(feature_names.index(name) for name in parsed)
         else:
             value = parsed
@@ -251,5 +253,9 @@ def question_difference(recorded: str, action: Action, describer, concepts) -> s
     asked = question_text(action, description=description, concepts=concepts, n_objects=describer.scene.n_objects)
     if recorded == asked:
         return ""
+    if action.kind == "label":  # a transcript from before the teacher's viewpoint: the old side words
+        old = SceneDescriber(describer.scene, describer.locations, OLD_WORLD_VIEWPOINT).describe(action.object_index)
+        if recorded == question_text(action, description=old, concepts=concepts, n_objects=describer.scene.n_objects):
+            return ""
     return (f"the recorded question {recorded!r} is not the replay's {asked!r}: the transcript was made with another "
             "seed, task or kitchen")

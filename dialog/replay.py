@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from dialog import records as checks
 from dialog.records import action_from_record, outcome_from_record
+from dialog.teachers import FastForwards
 from learning.errors import TranscriptError
 
 
@@ -50,18 +51,17 @@ def replay_turn(manager, record: dict) -> None:
         raise TranscriptError(f"turn {number}: {problem}")
     if decision.action != action:
         manager.replay_mismatches += 1
-    forward = getattr(manager.teacher, "fast_forward", None)
-    if action.kind != "none" and forward is not None:
-        forward(manager.prompt_for(action, decision.explanation, number, float(record.get("time", 0)), False))
+    if action.kind != "none" and isinstance(manager.teacher, FastForwards):
+        prompt = manager.prompt_for(action, decision.explanation, number, float(record.get("time", 0)), False)
+        manager.teacher.fast_forward(prompt)
     undid = record.get("undid", [])
     if len(undid) > len(manager._undo_stack) or [manager._undo() for _ in undid] != undid:
         raise TranscriptError(f"turn {number}: 'undid' is {undid} (expected the latest learned turns, newest "
                               "first)")
-    extra = manager._apply(action, outcome, manager.scene, replaying=True)
+    extra = manager._apply(action, outcome, manager.scene, replaying=True)  # learns and records the turn
     if "fetched" in record and extra.get("fetched", {}).get("kind") != record["fetched"].get("kind"):
         raise TranscriptError(f"turn {number}: the pantry fetch did not repeat ({extra.get('fetched')} instead of "
                               f"{record['fetched']})")
-    manager.state.record_turn(action)
     differs = checks.model_difference(record, manager.model_summary(), manager.state.remaining_budget)
     if differs:
         raise TranscriptError(f"turn {number}: {differs}")

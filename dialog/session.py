@@ -14,49 +14,36 @@ from pathlib import Path
 
 from bullet_world.datafiles import available, resolve
 from dialog.clock import VirtualClock, WallClock
-from dialog.manager import DialogManager, EpisodeConfig, episode_generators
+from dialog.manager import DialogManager, episode_generators
 from dialog.records import check_turn_record
-from dialog.teachers import ReplayTeacher, ScriptedTeacher
-from dialog.terminal import TerminalTeacher
-from dialog.transcript import VERSION, TranscriptWriter, read_numbered_session, read_session
+from dialog.settings import EpisodeSettings
+from dialog.teachers import SCRIPTED_OPTIONS, make_teacher
+from dialog.transcript import VERSION, TranscriptWriter, read_numbered_session
 from learning.actions import DEFAULT_COSTS
-from learning.errors import DataFileError, TranscriptError
+from learning.errors import DataFileError, SettingsError, TranscriptError
 from learning.strategies import STRATEGY_NAMES, make_strategy
 
-TEACHERS = ("terminal", "scripted", "replay")
-SCRIPTED_OPTIONS = ("mislabel_rate", "dont_know_rate", "feature_quality", "answer_delay")
+TEACHERS = ("terminal", "scripted", "replay")  # the kinds a teach session records
 
 
-@dataclass
-class SessionSettings:
-    """Everything that defines a session; stored in the transcript header."""
+@dataclass(frozen=True)
+class SessionSettings(EpisodeSettings):
+    """Everything that defines a teach session: the episode settings and the teacher; stored in the transcript
+    header."""
 
-    task: str = "pack-lunchbox"
-    kitchen: str = "kitchen-1"
-    strategy: str = "active"
-    seed: int = 0
-    turns: int = 30
-    budget: float = 40.0
-    change_every: int = 5
-    realtime: float | None = None
-    fetch_from_pantry: bool = True
-    costs: dict = field(default_factory=lambda: dict(DEFAULT_COSTS))
     teacher: dict = field(default_factory=lambda: {"kind": "terminal"})
 
     def __post_init__(self):
+        super().__post_init__()
         kind = self.teacher.get("kind")
         if kind not in TEACHERS:
-            raise ValueError(f"teacher '{kind}' is not one of {', '.join(TEACHERS)}")
+            raise SettingsError(f"teacher '{kind}' is not one of {', '.join(TEACHERS)}")
         unknown = sorted(set(self.teacher) - {"kind", "transcript", *SCRIPTED_OPTIONS})
         if unknown:
-            raise ValueError(f"unknown teacher options {unknown}; accepted: {', '.join(SCRIPTED_OPTIONS)}, transcript")
+            raise SettingsError(f"unknown teacher options {unknown}; accepted: {', '.join(SCRIPTED_OPTIONS)}, "
+                                "transcript")
         if kind == "replay" and not self.teacher.get("transcript"):
-            raise ValueError("a replay teacher needs the transcript to replay (--replay FILE)")
-
-    def config(self, pictures: str | None) -> EpisodeConfig:
-        return EpisodeConfig(turns=self.turns, budget=self.budget, change_every=self.change_every, seed=self.seed,
-                             costs=dict(self.costs), realtime=self.realtime, pictures=pictures,
-                             fetch_from_pantry=self.fetch_from_pantry)
+            raise SettingsError("a replay teacher needs the transcript to replay (--replay FILE)")
 
     def header(self) -> dict:
         return {"command": "teach", "task": self.task, "kitchen": self.kitchen, "teacher": dict(self.teacher)}
@@ -167,14 +154,12 @@ def make_clock(settings: SessionSettings, start: float = 0.0):
     return WallClock(start) if real else VirtualClock(start)
 
 
-def make_teacher(settings: SessionSettings, rngs, clock, input_stream=None, output_stream=None):
+def session_teacher(settings: SessionSettings, rngs, clock, input_stream=None, output_stream=None):
+    """The session's teacher, from its recorded kind and options (``dialog.teachers.make_teacher``)."""
     kind = settings.teacher["kind"]
-    if kind == "terminal":
-        return TerminalTeacher(input_stream, output_stream, clock=clock)
-    if kind == "scripted":
-        options = {key: settings.teacher[key] for key in SCRIPTED_OPTIONS if key in settings.teacher}
-        return ScriptedTeacher(rngs["teacher"], clock=clock, **options)
-    return ReplayTeacher(read_session(settings.teacher["transcript"])[1])
+    options = {key: settings.teacher[key] for key in SCRIPTED_OPTIONS if key in settings.teacher and kind == "scripted"}
+    return make_teacher(kind, rng=rngs["teacher"], clock=clock, transcript=settings.teacher.get("transcript"),
+                        input_stream=input_stream, output_stream=output_stream, **options)
 
 
 def open_session(settings: SessionSettings, environment, transcript_path: str | Path, *, resume: bool = False,
@@ -201,7 +186,7 @@ def open_session(settings: SessionSettings, environment, transcript_path: str | 
             start = float(numbered[-1][1].get("ended", numbered[-1][1].get("time", 0.0)))
     rngs = episode_generators(settings.seed)
     clock = make_clock(settings, start)
-    teacher = make_teacher(settings, rngs, clock, input_stream, output_stream)
+    teacher = session_teacher(settings, rngs, clock, input_stream, output_stream)
     transcript = TranscriptWriter(transcript_path, append=resume, lock=lock)
     manager = DialogManager(environment, teacher, make_strategy(settings.strategy), settings.config(pictures),
                             transcript, rngs, say=say or print, observers=observers, clock=clock,

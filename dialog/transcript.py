@@ -120,8 +120,15 @@ def read_numbered_session(path: str | Path, tolerate_partial_tail: bool = False
     line without a newline when ``tolerate_partial_tail`` (a crash mid-write).
     """
     header, records = None, []
-    with open(path, encoding="utf-8", errors="replace") as handle:
-        lines = handle.readlines()
+    try:
+        with open(path, encoding="utf-8", errors="replace") as handle:
+            lines = handle.readlines()
+    except FileNotFoundError:
+        raise TranscriptError(f"{path}: no such transcript; give a transcript file that teachbot wrote") from None
+    except IsADirectoryError:
+        raise TranscriptError(f"{path} is a folder; give a transcript file that teachbot wrote") from None
+    except PermissionError:
+        raise TranscriptError(f"{path}: cannot read the transcript (no permission)") from None
     for number, line in enumerate(lines, start=1):
         if not line.strip():
             continue

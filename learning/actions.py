@@ -7,8 +7,12 @@ label query 1, no query 0 (configurable).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Literal, get_args
 
-DEFAULT_COSTS = {"label": 1, "demo": 2, "feature": 2, "none": 0}
+ActionKind = Literal["label", "demo", "feature", "none"]
+ACTION_KINDS: tuple[ActionKind, ...] = get_args(ActionKind)  # label, demo, feature, none
+
+DEFAULT_COSTS: dict[ActionKind, float] = {"label": 1, "demo": 2, "feature": 2, "none": 0}
 
 
 @dataclass(frozen=True)
@@ -16,7 +20,7 @@ class LabelQuery:
     """Point at scene object ``object_index`` and ask what it is (LQ)."""
 
     object_index: int
-    kind: str = "label"
+    kind: Literal["label"] = "label"
 
 
 @dataclass(frozen=True)
@@ -24,21 +28,21 @@ class DemoQuery:
     """Ask the teacher to show an example of ``concept`` (DQ)."""
 
     concept: str
-    kind: str = "demo"
+    kind: Literal["demo"] = "demo"
 
 
 @dataclass(frozen=True)
 class FeatureQuery:
     """Ask which features tell the concepts apart (FSQ, asked at most once)."""
 
-    kind: str = "feature"
+    kind: Literal["feature"] = "feature"
 
 
 @dataclass(frozen=True)
 class NoQuery:
     """Stay quiet this turn."""
 
-    kind: str = "none"
+    kind: Literal["none"] = "none"
 
 
 Action = LabelQuery | DemoQuery | FeatureQuery | NoQuery

@@ -1,7 +1,8 @@
 """The one base class for errors that reach a user as a single message, never a traceback.
 
-The command line catches :class:`TeachbotError` (and, for now, the ``ValueError``
-family it derives from) and prints ``teachbot COMMAND: message``. A message names
+The command line catches :class:`TeachbotError` (and nothing else) and prints
+``teachbot COMMAND: message``; it stays a ``ValueError`` so that library users who
+catch ``ValueError`` still catch it. A message names
 what was wrong (the file, line, field, path or answer) and what is accepted.
 Anything else is a bug and keeps its traceback.
 """
@@ -23,3 +24,21 @@ class OutputPathError(TeachbotError):
 
 class TranscriptError(TeachbotError):
     """A transcript cannot be resumed or is held by another process."""
+
+
+class SettingsError(TeachbotError):
+    """A setting (a command-line option, an episode or teacher setting, a suite option) has a value not accepted."""
+
+
+class SceneError(TeachbotError, RuntimeError):
+    """The kitchen, task or recipe cannot hold what was asked of it (objects that do not fit, a missing location).
+
+    Also a ``RuntimeError``, which placement failures were before.
+    """
+
+
+class SetupError(TeachbotError, RuntimeError):
+    """An optional extra or a facility the command needs (Ray, Chromium, the viewer server) is missing or failed.
+
+    Also a ``RuntimeError``, which these were before.
+    """

@@ -37,6 +37,7 @@ from dataclasses import dataclass
 import numpy as np
 import pybullet as p
 
+from learning.errors import SettingsError
 from robot.arm import FINGER_JOINTS, HAND_LINK, Arm, MotionResult
 
 MAX_OPENING_M = 0.08            # the Panda's full finger opening
@@ -197,7 +198,7 @@ class Gripper:
 
     def __init__(self, arm: Arm, mode: str = FRICTION, ignore_bodies: tuple[int, ...] = ()):
         if mode not in GRASP_MODES:
-            raise ValueError(f"unknown grasp mode {mode!r}; accepted: {', '.join(GRASP_MODES)}")
+            raise SettingsError(f"unknown grasp mode {mode!r}; accepted: {', '.join(GRASP_MODES)}")
         self.arm = arm
         couple_fingers(arm)
         self.mode = mode

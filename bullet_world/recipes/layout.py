@@ -34,7 +34,7 @@ from bullet_world.bodies import outline
 from bullet_world.catalogue import ObjectKind
 from bullet_world.kitchen import Kitchen
 from bullet_world.meshes import true_size
-from bullet_world.placement import Footprint
+from bullet_world.placement import Footprint, PlacementError
 from bullet_world.recipes.setup import ELSEWHERE, RecipeSceneSetup
 
 LOCAL_TRIES = 40     # proposals around a target spot before placing an object afresh
@@ -186,7 +186,7 @@ class Placer:
             result = self._try_arrangement(homes, radii, steps, rng, previous)
             if result is not None:
                 return result
-        raise RuntimeError(
+        raise PlacementError(
             f"cannot arrange {len(homes)} objects without overlap in kitchen '{self.kitchen.name}' within reach "
             f"{list(self.setup.reach)} m; accepted: fewer or smaller objects per location, or larger regions")
 

@@ -20,6 +20,8 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
+from learning.errors import SceneError
+
 APPEARANCE_SCALE = np.array([0.03, 0.03, 0.03, 0.01, 0.01, 0.01])
 LOCATION_SCALE_M = 0.5
 
@@ -35,7 +37,7 @@ def match_rows(before_appearance: np.ndarray, before_locations: np.ndarray, afte
     a0, l0 = np.asarray(before_appearance, float), np.asarray(before_locations, float)
     a1, l1 = np.asarray(after_appearance, float), np.asarray(after_locations, float)
     if a0.shape[0] != a1.shape[0] or l0.shape[0] != a0.shape[0] or l1.shape[0] != a1.shape[0]:
-        raise ValueError(f"cannot match {a0.shape[0]} objects before with {a1.shape[0]} after; "
+        raise SceneError(f"cannot match {a0.shape[0]} objects before with {a1.shape[0]} after; "
                          "accepted: the same objects seen in both observations")
     scale = np.asarray(appearance_scale, dtype=float)
     appearance = (a0[:, None, :] - a1[None, :, :]) / scale

@@ -35,6 +35,7 @@ from bullet_world.perception import ObjectMeasurement, measure_objects
 from bullet_world.recipes.layout import Arrangement, Placer, object_radius_and_height
 from bullet_world.recipes.setup import ELSEWHERE, load_recipe_setup
 from bullet_world.world import World
+from learning.errors import SceneError, SettingsError
 
 APPEARANCE_NAMES = ("r", "g", "b", "length", "width", "height")
 LOCATION_NAMES = ("x", "y", "z")
@@ -107,16 +108,16 @@ class RecipeWorld:
         roles = self.household.roles()
         for obj, start, _end in self.steps:
             if obj not in roles:
-                raise ValueError(f"household '{self.household.name}' of task '{self.setup.task}' has no object "
+                raise SceneError(f"household '{self.household.name}' of task '{self.setup.task}' has no object "
                                  f"playing '{obj}'; roles it has: {', '.join(sorted(roles)) or 'none'}")
             if roles[obj].at != start:
-                raise ValueError(f"household '{self.household.name}': the {obj} lives at '{roles[obj].at}', but "
+                raise SceneError(f"household '{self.household.name}': the {obj} lives at '{roles[obj].at}', but "
                                  f"the recipe takes it from '{start}'")
         used = sorted({s for _, s, _ in self.steps} | {e for _, _, e in self.steps}
                       | {item.at for item in self.household.objects} - {ELSEWHERE})
         missing = [name for name in used if name not in self.kitchen.locations]
         if missing:
-            raise ValueError(f"kitchen '{self.kitchen.name}' has no location {missing[0]!r}; it has: "
+            raise SceneError(f"kitchen '{self.kitchen.name}' has no location {missing[0]!r}; it has: "
                              f"{', '.join(sorted(self.kitchen.locations))}")
         recipe_locations = tuple(dict.fromkeys(name for step in self.steps for name in step[1:]))
         self.placer = Placer(self.kitchen, self.setup, recipe_locations)
@@ -166,7 +167,7 @@ class RecipeWorld:
     # -------------------------------------------------------------- arranging
     def set_lighting(self, name: str) -> None:
         if name not in self.setup.lighting:
-            raise ValueError(f"unknown lighting {name!r}; accepted: {', '.join(self.setup.lighting)}")
+            raise SettingsError(f"unknown lighting {name!r}; accepted: {', '.join(self.setup.lighting)}")
         self.lighting_name = name
         self.world.lighting = self.setup.lighting[name]
 
@@ -220,7 +221,7 @@ class RecipeWorld:
         that start a new sweep.
         """
         if not isinstance(count, (int, np.integer)) or count < 1:
-            raise ValueError(f"the number of demonstrations must be a whole number >= 1, got {count!r}")
+            raise SettingsError(f"the number of demonstrations must be a whole number >= 1, got {count!r}")
         conditions = list(self.setup.lighting)
         per_sweep = self.setup.layouts
         targets: list[Arrangement] = []

@@ -19,9 +19,10 @@ import umsgpack
 from meshcat.geometry import pack_numpy_array
 
 from bullet_world.datafiles import cache_dir, write_atomically
+from learning.errors import DataFileError
 
 
-class MeshFileError(ValueError):
+class MeshFileError(DataFileError):
     """An OBJ file that can't be read as triangles."""
 
 

@@ -26,6 +26,7 @@ import umsgpack
 from bullet_world.viewer.meshcat_objects import MOVE_TOLERANCE, RawObject, object_jsons, set_camera
 from bullet_world.viewer.scene import Frame, Look, same_pose
 from bullet_world.viewer.server import LocalServer, QuietWindow
+from learning.errors import SettingsError
 
 
 @dataclass
@@ -57,7 +58,7 @@ class Recording:
 
     def __init__(self, fps: int = 30):
         if fps < 1:
-            raise ValueError(f"the recording's frame rate must be at least 1 per second, got {fps}")
+            raise SettingsError(f"the recording's frame rate must be at least 1 per second, got {fps}")
         self.fps = fps
         self.versions: list[Version] = []
         self._open: dict[str, Version] = {}

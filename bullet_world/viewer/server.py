@@ -20,6 +20,8 @@ import umsgpack
 import zmq
 from meshcat.visualizer import ViewerWindow
 
+from learning.errors import SetupError
+
 LOOPBACK = "127.0.0.1"
 SERVER_SCRIPT = Path(__file__).with_name("server_process.py")
 START_TIMEOUT_S = 20.0
@@ -27,7 +29,7 @@ REPLY_TIMEOUT_MS = 10_000
 MAX_PENDING = 256
 
 
-class ViewerError(RuntimeError):
+class ViewerError(SetupError):
     """The meshcat server could not be started or stopped answering."""
 
 

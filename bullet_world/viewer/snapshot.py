@@ -12,6 +12,8 @@ import tempfile
 import time
 from pathlib import Path
 
+from learning.errors import SetupError
+
 CHROMIUM_CANDIDATES = ("/usr/bin/chromium", "/usr/bin/chromium-browser", "/usr/bin/google-chrome")
 CHROMIUM_FLAGS = ("--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
                   "--disable-component-update", "--disable-sync", "--no-first-run", "--use-angle=swiftshader",
@@ -34,7 +36,7 @@ def find_chromium() -> str | None:
     return shutil.which("chromium")
 
 
-class SnapshotError(RuntimeError):
+class SnapshotError(SetupError):
     """The page could not be opened, or never showed a scene."""
 
 

@@ -9,6 +9,7 @@ from pathlib import Path
 
 from dialog.commands._arguments import positive_int
 from dialog.output_paths import check_writable, writing
+from learning.errors import OutputPathError
 
 
 def register(commands) -> None:
@@ -40,9 +41,9 @@ def run(args: argparse.Namespace, output_stream=None) -> int:
 
     out = output_stream or sys.stdout
     if args.out.suffix != ".toml":
-        raise ValueError(f"--out {args.out}: a weights file must end in .toml")
+        raise OutputPathError(f"--out {args.out}: a weights file must end in .toml")
     if not args.out.parent.exists():
-        raise FileNotFoundError(f"--out {args.out}: the directory {args.out.parent} does not exist")
+        raise OutputPathError(f"--out {args.out}: the directory {args.out.parent} does not exist")
     check_writable(args.out, "weights file")  # before the fit, which takes a while
     learned = learn_weights(args.demos, args.iterations, args.seed, args.validation, args.policy)
     with writing(args.out, "weights file"):

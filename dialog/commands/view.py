@@ -16,6 +16,7 @@ import time
 from pathlib import Path
 
 from dialog.commands._arguments import positive_int, seconds
+from learning.errors import SettingsError
 
 
 def register(commands) -> None:
@@ -51,7 +52,7 @@ def run(args: argparse.Namespace) -> int:
     try:
         scene = environment.next_scene(episode_generators(args.seed)["scenes"])
         if args.point is not None and args.point > scene.n_objects:
-            raise ValueError(f"--point {args.point}: the scene has objects 1 to {scene.n_objects}")
+            raise SettingsError(f"--point {args.point}: the scene has objects 1 to {scene.n_objects}")
         viewer = Viewer(environment.world, record=args.export is not None)
         try:
             viewer.start_recording()

@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from dialog.commands._arguments import positive_int
+from learning.errors import SettingsError
 
 KITCHENS = ("kitchen-1", "kitchen-2", "kitchen-3")
 
@@ -63,7 +64,7 @@ def run_show(args: argparse.Namespace) -> int:
     from bullet_world.annotate import annotate, write_png
 
     if args.png.suffix.lower() != ".png":
-        raise ValueError(f"--png must name a .png file, got '{args.png}'")
+        raise SettingsError(f"--png must name a .png file, got '{args.png}'")
     with World(task=args.task, kitchen=args.kitchen, seed=args.seed, objects_per_scene=args.objects) as world:
         if args.robot:
             from robot import Arm

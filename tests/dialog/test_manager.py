@@ -329,3 +329,34 @@ def test_a_recorded_failed_fetch_replays_on_resume(tmp_path):
                             TranscriptWriter(tmp_path / "u.jsonl"), episode_generators(0), say=lambda _: None)
     result = resumed.run(replay=records)
     assert result.completed == 3 and resumed.state.counts_per_concept() == first.state.counts_per_concept()
+
+
+def test_an_undo_before_there_is_none_to_show_still_marks_the_concept_absent(tmp_path):
+    """The old trap: the turn was recorded after the answer by counting examples, so an undo in the same turn
+    hid that no demonstration came back. Now the one apply records the turn from the answer itself."""
+    env = FakeEnvironment(missing=("snack",))
+    teacher = LineTeacher(["a fruit", "undo", "none"])
+    manager = manager_for(tmp_path / "t.jsonl", env, teacher, ScriptedStrategy([LabelQuery(0), DemoQuery("snack")]),
+                          turns=2, budget=5, fetch_from_pantry=False)
+    manager.run()
+    records = read_transcript(tmp_path / "t.jsonl")
+    assert records[1]["undid"] == [1] and records[1]["answer"]["kind"] == "absent"
+    assert "snack" in manager.state.absent_in_scene and manager.state.examples == ()
+    assert manager.state.history == ("label", "demo") and manager.state.spent == 3 == 5 - records[1]["budget_left"]
+
+
+def test_undo_takes_back_a_feature_choice_and_a_pantry_example(tmp_path):
+    teacher = LineTeacher(["none", "ignore f3", "undo", "undo", "a snack"])
+    env = PantryEnvironment(missing=("fruit",))
+    manager = manager_for(tmp_path / "t.jsonl", env, teacher,
+                          ScriptedStrategy([DemoQuery("fruit"), FeatureQuery(), LabelQuery(1)]), turns=3, budget=8)
+    manager.run()
+    records = read_transcript(tmp_path / "t.jsonl")
+    assert records[0]["fetched"]["kind"] == "fruit-from-pantry" and records[1]["model"]["features_in_use"] == 2
+    assert records[2]["undid"] == [2, 1]
+    assert any("Taken back: the choice of 2 features (turn 2)" in h for h in teacher.heard)
+    assert any("Taken back: the fruit from the pantry (turn 1)" in h for h in teacher.heard)
+    assert all(s is None for s in manager.state.feature_subsets.values())
+    assert records[2]["model"]["features_in_use"] == 3
+    assert [e.concept for e in manager.state.examples] == ["snack"] and manager.state.feature_query_asked
+    assert [r["budget_left"] for r in records] == [6, 4, 3]  # the undone turns stay spent

@@ -1,0 +1,85 @@
+"""The settings of one teaching episode, with their defaults written once.
+
+``EpisodeSettings`` is shared by ``demo``, ``teach`` (``SessionSettings`` adds
+the teacher), ``expert`` (``ExpertSettings``, the thesis's training condition)
+and the regression suites (``EpisodeSpec.settings()``); the command-line
+defaults are read from :data:`DEFAULTS`. Bad values are refused when the
+settings are made, with a :class:`~learning.errors.SettingsError` naming the option.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from numbers import Integral, Real
+
+from learning.actions import DEFAULT_COSTS
+from learning.errors import SettingsError
+
+__all__ = ["DEFAULTS", "EpisodeSettings", "check_allocation", "check_costs"]
+
+
+def check_allocation(turns, budget, change_every, realtime=None, seed=0) -> None:
+    """T turns, budget B, a change every r turns, seconds per turn (None: turn-based) and the seed, or SettingsError."""
+    if not _is_int(turns) or turns < 1:
+        raise SettingsError(f"turns must be at least 1, got {turns}")
+    if not (isinstance(budget, Real) and not isinstance(budget, bool) and budget >= 0):
+        raise SettingsError(f"budget must be zero or more, got {budget}")
+    if not _is_int(change_every) or change_every < 1:
+        raise SettingsError(f"change-every must be at least 1 turn, got {change_every}")
+    if realtime is not None and not (_is_number(realtime) and realtime > 0):
+        raise SettingsError(f"realtime must be a positive number of seconds per turn, got {realtime}")
+    if not _is_int(seed) or seed < 0:
+        raise SettingsError(f"seed must be a whole number of 0 or more, got {seed}")
+
+
+def check_costs(costs) -> None:
+    """A cost of zero or more for each query kind, or SettingsError."""
+    if not hasattr(costs, "keys") or set(costs) != set(DEFAULT_COSTS) or \
+            not all(_is_number(value) and value >= 0 for value in costs.values()):
+        raise SettingsError(f"costs must give a cost of 0 or more for each of {', '.join(DEFAULT_COSTS)}; "
+                            f"got {dict(costs) if hasattr(costs, 'keys') else costs!r}")
+
+
+@dataclass(frozen=True)
+class EpisodeSettings:
+    """Everything that defines one episode apart from its teacher; frozen, validated when made."""
+
+    task: str = "pack-lunchbox"
+    kitchen: str = "kitchen-1"
+    strategy: str = "active"
+    seed: int = 0
+    turns: int = 30
+    budget: float = 40.0
+    change_every: int = 5
+    realtime: float | None = None
+    fetch_from_pantry: bool = True
+    costs: dict = field(default_factory=lambda: dict(DEFAULT_COSTS))
+
+    def __post_init__(self):
+        for name, value in (("task", self.task), ("kitchen", self.kitchen), ("strategy", self.strategy)):
+            if not isinstance(value, str) or not value:
+                raise SettingsError(f"{name} must be a name, got {value!r}")
+        check_allocation(self.turns, self.budget, self.change_every, self.realtime, self.seed)
+        if not isinstance(self.fetch_from_pantry, bool):
+            raise SettingsError(f"fetch_from_pantry must be true or false, got {self.fetch_from_pantry!r}")
+        check_costs(self.costs)
+
+    def config(self, pictures: str | None = None):
+        """The manager's allocation for this episode (``pictures``: folder for scene pictures, None: none)."""
+        from dialog.manager import EpisodeConfig  # the manager imports this module
+
+        return EpisodeConfig(turns=self.turns, budget=self.budget, change_every=self.change_every, seed=self.seed,
+                             costs=dict(self.costs), realtime=self.realtime, pictures=pictures,
+                             fetch_from_pantry=self.fetch_from_pantry)
+
+
+def _is_int(value) -> bool:
+    return isinstance(value, Integral) and not isinstance(value, bool)
+
+
+def _is_number(value) -> bool:
+    return isinstance(value, Real) and not isinstance(value, bool) and math.isfinite(value)
+
+
+DEFAULTS = EpisodeSettings()
