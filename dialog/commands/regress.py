@@ -1,27 +1,18 @@
-"""``teachbot regress``: run a suite of scripted-teacher episodes, report, and compare with a baseline."""
+"""``teachbot regress``: run a suite of scripted-teacher episodes, report, and compare with a baseline.
+
+The command parses its arguments and prints; the suite's kind (``dialog/experiments/kinds.py``)
+does the work: load, run, report, check.
+"""
 
 from __future__ import annotations
 
 import argparse
 import json
-import time
 from pathlib import Path
 
 from dialog.commands._arguments import budget, positive_int
-from dialog.experiments.analysis import evaluate_findings, summarise
-from dialog.experiments.baseline import baseline_path, check_against_baseline, write_baseline
-from dialog.experiments.features.report import feature_summaries, run_feature_suite, write_feature_report
-from dialog.experiments.pools import load_pools
-from dialog.experiments.recipes.report import write_recipe_report
-from dialog.experiments.recipes.suite import (
-    evaluate_recipe_findings,
-    load_study,
-    run_recipe_suite,
-    summarise_study,
-    trial_count,
-)
-from dialog.experiments.report import markdown_report, plot_learning_curves, plot_question_timing, write_episode_csvs
-from dialog.experiments.runner import episode_specs, run_locally, run_on_ray
+from dialog.experiments.baseline import baseline_path, write_baseline
+from dialog.experiments.kinds import RunOptions, get_kind, run_suite
 from dialog.experiments.suite import load_suite, suite_names
 from dialog.output_paths import check_writable, writing
 from learning.strategies import STRATEGY_NAMES
@@ -46,61 +37,28 @@ def register(commands) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    suite = load_suite(args.suite, known_strategies=STRATEGY_NAMES).with_overrides(
-        strategies=args.strategies, seeds=args.seeds, budget=args.budget, datasets=args.datasets)
-    if suite.kind == "episodes":
-        unknown = [s for s in suite.strategies if s not in STRATEGY_NAMES]
-        if unknown:
-            raise ValueError(f"unknown strategies {unknown}; choose from: {', '.join(STRATEGY_NAMES)}")
+    original = load_suite(args.suite, known_strategies=STRATEGY_NAMES)
+    kind = get_kind(original.kind)
+    suite = kind.load(original.with_overrides(strategies=args.strategies, seeds=args.seeds, budget=args.budget,
+                                              datasets=args.datasets))
     out = args.results or Path("results") / suite.name
     check_writable(out, "results", folder=True)
     with writing(out, "results", inside=True):
         out.mkdir(parents=True, exist_ok=True)
-        return _run_suite(args, suite, out)
-
-
-def _run_suite(args: argparse.Namespace, suite, out: Path) -> int:
-    started = time.perf_counter()
-    if suite.kind == "feature-selection":
-        rows = run_feature_suite(suite, load_pools(suite.task, suite.kitchen, 1, suite.plan_options))
-        seconds = time.perf_counter() - started
-        summaries = feature_summaries(rows, suite)
-        findings = evaluate_findings(summaries, suite)
-        report = write_feature_report(suite, rows, summaries, findings, seconds, out)
-        count = len(rows)
-    elif suite.kind == "episodes":
-        load_pools(suite.task, suite.kitchen, suite.datasets, suite.plan_options)  # render once, before workers
-        specs = episode_specs(suite, out)
-        progress = not args.no_progress
-        results = run_on_ray(specs, args.ray, progress) if args.ray else run_locally(specs, args.workers, progress)
-        seconds = time.perf_counter() - started
-        summaries = summarise(results, suite)
-        findings = evaluate_findings(summaries, suite)
-        write_episode_csvs(results, out)
-        figures = plot_learning_curves(results, suite, out) + plot_question_timing(results, suite, out)
-        report = markdown_report(suite, results, summaries, findings, seconds, out, figures)
-        count = len(results)
-    elif suite.kind == "recipes":
-        study = load_study(suite)
-        results = run_recipe_suite(study, args.workers, not args.no_progress)
-        seconds = time.perf_counter() - started
-        summaries = summarise_study(results, study)
-        findings = evaluate_recipe_findings(summaries, suite)
-        count = trial_count(results)
-        report = write_recipe_report(suite, study, results, summaries, findings, seconds, out, count)
-    else:
-        raise ValueError(f"suite '{suite.name}' is of kind '{suite.kind}', which this version cannot run yet")
-    print(f"{suite.name}: {count} runs in {seconds:.1f} s; report {report}")
-    for outcome in findings:
-        ps = ", ".join(f"{c.b} p={c.p:.3g}" for c in outcome.comparisons)
-        print(f"  {outcome.finding.id}: {'holds' if outcome.holds else 'does not hold'} ({ps})")
+        options = RunOptions(results=out, workers=args.workers, ray=args.ray, progress=not args.no_progress)
+        outcome = run_suite(kind, suite, options, original)
+        report = kind.report(outcome, out)[0]
+    print(f"{suite.name}: {outcome.count} runs in {outcome.seconds:.1f} s; report {report}")
+    for finding in outcome.findings:
+        ps = ", ".join(f"{c.b} p={c.p:.3g}" for c in finding.comparisons)
+        print(f"  {finding.finding.id}: {finding.verdict}" + (f" ({ps})" if ps else ""))
     if args.update_baseline:
         with writing(baseline_path(suite), "baseline"):
-            print(f"baseline written to {write_baseline(suite, summaries)}")
-    failures = check_against_baseline(suite, summaries) if args.check else []
+            print(f"baseline written to {write_baseline(suite, outcome.summaries)}")
+    failures = kind.check(outcome) if args.check else []
     for failure in failures:
         print(f"  REGRESSION {failure}")
     if args.json:
-        print(json.dumps({"suite": suite.name, "episodes": count, "seconds": round(seconds, 2),
+        print(json.dumps({"suite": suite.name, "episodes": outcome.count, "seconds": round(outcome.seconds, 2),
                           "passed": not failures, "failures": failures}))
     return 1 if failures else 0

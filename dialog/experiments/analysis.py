@@ -11,20 +11,26 @@ from dialog.experiments.suite import Finding, Suite
 from learning.significance import Comparison, accuracy_after_questions, mann_whitney, mean_and_standard_error
 
 
-def checkpoint_values(result: dict, suite: Suite) -> np.ndarray:
-    """One episode's accuracy at each of the suite's checkpoints (questions asked, or turns).
+def condition_checkpoints(suite: Suite, turns: int) -> tuple[int, ...]:
+    """The suite's checkpoints a condition of ``turns`` turns can reach (no more questions than turns either)."""
+    return tuple(c for c in suite.checkpoints if c <= turns)
+
+
+def checkpoint_values(result: dict, suite: Suite, checkpoints: tuple[int, ...] | None = None) -> np.ndarray:
+    """One episode's accuracy at each checkpoint (default: the suite's), in questions asked or turns.
 
     An episode that never asked as many questions as a checkpoint (its strategy
     chose to stay quiet, or its time ran out) counts with its final accuracy:
     that is what it learned with what it chose to ask.
     """
+    checkpoints = suite.checkpoints if checkpoints is None else checkpoints
     series = result["series"]
     accuracy = np.asarray(series["accuracy"], dtype=float)
     if suite.axis == "questions":
-        values = accuracy_after_questions(np.asarray(series["questions"]), accuracy, suite.checkpoints)
+        values = accuracy_after_questions(np.asarray(series["questions"]), accuracy, checkpoints)
         return np.where(np.isnan(values), accuracy[-1], values)
     turns = np.asarray(series["turn"])
-    return np.array([accuracy[turns <= t][-1] if np.any(turns <= t) else np.nan for t in suite.checkpoints])
+    return np.array([accuracy[turns <= t][-1] if np.any(turns <= t) else np.nan for t in checkpoints])
 
 
 def group_results(results: list[dict]) -> dict[tuple[str, str], list[dict]]:
@@ -47,32 +53,58 @@ class CheckpointSummary:
 
 
 def summarise(results: list[dict], suite: Suite) -> list[CheckpointSummary]:
+    """One summary per (condition, strategy), at the checkpoints inside the condition's turns."""
     summaries = []
     for (condition, strategy), group in group_results(results).items():
-        values = np.vstack([checkpoint_values(r, suite) for r in group])
+        turns = group[0]["spec"]["condition"].get("turns")
+        checkpoints = suite.checkpoints if turns is None else condition_checkpoints(suite, int(turns))
+        values = np.vstack([checkpoint_values(r, suite, checkpoints) for r in group]).reshape(len(group), -1)
         mean, error = mean_and_standard_error(values)
-        summaries.append(CheckpointSummary(condition, strategy, suite.checkpoints, mean, error, values))
+        summaries.append(CheckpointSummary(condition, strategy, checkpoints, mean, error, values))
     return summaries
 
 
 @dataclass(frozen=True)
 class FindingResult:
+    """A finding's tests; a finding that could not be tested has no comparisons and says why in ``skipped``."""
+
     finding: Finding
     comparisons: tuple[Comparison, ...]
+    skipped: str = ""
 
     @property
     def holds(self) -> bool:
-        return bool(self.comparisons) and all(c.significant for c in self.comparisons)
+        return not self.skipped and bool(self.comparisons) and all(c.significant for c in self.comparisons)
+
+    @property
+    def verdict(self) -> str:
+        return f"skipped: {self.skipped}" if self.skipped else "holds" if self.holds else "does not hold"
+
+
+def skipped_by_overrides(original: Suite, suite: Suite) -> list[FindingResult]:
+    """The findings of ``original`` that the command-line strategy subset of ``suite`` left out, with the reason."""
+    kept = {finding.id for finding in suite.findings}
+    skipped = []
+    for finding in (f for f in original.findings if f.id not in kept):
+        missing = [s for s in (finding.better, *finding.than) if s not in suite.strategies]
+        skipped.append(FindingResult(finding, (), f"needs {', '.join(missing)}, not among the strategies run "
+                                                  f"({', '.join(suite.strategies)})"))
+    return skipped
 
 
 def evaluate_findings(summaries: list[CheckpointSummary], suite: Suite) -> list[FindingResult]:
-    """One-tailed (or as the suite says) Mann-Whitney tests of each finding at its checkpoint."""
+    """One-tailed (or as the suite says) Mann-Whitney tests of each finding at its checkpoint.
+
+    A finding whose checkpoint lies beyond its condition's turns, or whose strategies have no
+    results, comes back skipped with the reason (the episodes kind checks checkpoints on loading).
+    """
     lookup = {(s.condition, s.strategy): s for s in summaries}
     outcomes = []
     for finding in suite.findings:
-        if finding.at not in suite.checkpoints:
-            raise ValueError(f"finding '{finding.id}' is checked at {finding.at}, which is not a checkpoint "
-                             f"of suite '{suite.name}' {list(suite.checkpoints)}")
+        reason = _untestable(finding, lookup, suite)
+        if reason:
+            outcomes.append(FindingResult(finding, (), reason))
+            continue
         better_summary = lookup[(finding.condition, finding.better)]
         column = better_summary.checkpoints.index(finding.at)
         better = better_summary.values[:, column]
@@ -83,6 +115,21 @@ def evaluate_findings(summaries: list[CheckpointSummary], suite: Suite) -> list[
                                             finding.alternative))
         outcomes.append(FindingResult(finding, tuple(comparisons)))
     return outcomes
+
+
+def _untestable(finding: Finding, lookup: dict, suite: Suite) -> str:
+    """Why ``finding`` cannot be tested with these summaries ("" when it can)."""
+    axis = "questions" if suite.axis == "questions" else suite.axis
+    for strategy in (finding.better, *finding.than):
+        summary = lookup.get((finding.condition, strategy))
+        if summary is None:
+            return f"no results for {strategy} in condition '{finding.condition}'"
+        if finding.at not in summary.checkpoints:
+            turns = next((c.turns for c in suite.conditions if c.name == finding.condition), None)
+            if turns is not None and finding.at > turns:
+                return f"it compares after {finding.at} {axis}, beyond the condition's {turns} turns"
+            return f"{finding.at} is not a checkpoint of condition '{finding.condition}' {list(summary.checkpoints)}"
+    return ""
 
 
 def pairwise(summaries: list[CheckpointSummary], condition: str, column: int) -> list[Comparison]:

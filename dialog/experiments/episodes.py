@@ -14,9 +14,12 @@ import numpy as np
 
 from dialog.experiments.pools import PoolEnvironment, load_pools
 from dialog.experiments.suite import Condition
-from dialog.manager import DialogManager, EpisodeConfig, episode_generators
+from dialog.manager import DialogManager, episode_generators
+from dialog.settings import EpisodeSettings
+from dialog.teachers import make_teacher
 from dialog.threads import one_blas_thread
 from dialog.transcript import TranscriptWriter, read_transcript
+from learning.errors import SettingsError
 from learning.strategies import make_strategy
 
 SERIES = ("turn", "accuracy", "questions", "label", "demo", "feature", "spent")
@@ -45,22 +48,25 @@ class EpisodeSpec:
     def label(self) -> str:
         return f"{self.strategy}/{self.condition.name}/d{self.dataset}/s{self.seed}"
 
+    def settings(self) -> EpisodeSettings:
+        """The episode's settings: this spec's task, kitchen, strategy and costs, the condition's allocation."""
+        condition = self.condition
+        return EpisodeSettings(task=self.task, kitchen=self.kitchen, strategy=self.strategy, seed=self.episode_seed,
+                               turns=condition.turns, budget=condition.budget, change_every=condition.change_every,
+                               costs=dict(self.costs))
+
 
 TEACHER_OPTIONS = ("kind", "mislabel_rate", "dont_know_rate", "feature_quality")
 
 
-def make_teacher(options: dict, rng: np.random.Generator):
+def suite_teacher(options: dict, rng: np.random.Generator):
     """A scripted teacher (``kind = "scripted"``, the default; ``"oracle"`` = perfect) from suite options."""
-    from dialog.teachers import OracleTeacher, ScriptedTeacher
-
     unknown = sorted(set(options) - set(TEACHER_OPTIONS))
     kind = options.get("kind", "scripted")
     if unknown or kind not in ("scripted", "oracle"):
-        raise ValueError(f"teacher options {options} not supported; accepted: kind = 'scripted' or 'oracle', "
-                         f"mislabel_rate, dont_know_rate, feature_quality (each 0..1)")
-    if kind == "oracle":
-        return OracleTeacher(rng)
-    return ScriptedTeacher(rng, **{k: float(v) for k, v in options.items() if k != "kind"})
+        raise SettingsError(f"teacher options {options} not supported; accepted: kind = 'scripted' or 'oracle', "
+                            f"mislabel_rate, dont_know_rate, feature_quality (each 0..1)")
+    return make_teacher(kind, rng=rng, **{k: v for k, v in options.items() if k != "kind"})
 
 
 def run_episode(spec: EpisodeSpec) -> dict:
@@ -75,12 +81,11 @@ def _run_episode(spec: EpisodeSpec) -> dict:
     condition = spec.condition
     scenes = -(-condition.turns // max(condition.change_every, 1))
     environment = PoolEnvironment(pools.train[spec.dataset], pools.test, pools.task, scenes)
-    config = EpisodeConfig(turns=condition.turns, budget=condition.budget, change_every=condition.change_every,
-                           seed=spec.episode_seed, costs=dict(spec.costs))
+    config = spec.settings().config()
     rngs = episode_generators(spec.episode_seed)
     Path(spec.transcript).parent.mkdir(parents=True, exist_ok=True)
     with TranscriptWriter(spec.transcript) as transcript:
-        result = DialogManager(environment, make_teacher(dict(spec.teacher), rngs["teacher"]),
+        result = DialogManager(environment, suite_teacher(dict(spec.teacher), rngs["teacher"]),
                                make_strategy(spec.strategy), config, transcript, rngs, say=lambda _: None).run()
     series = series_from_transcript(read_transcript(spec.transcript))
     return {"spec": asdict(spec), "label": spec.label, "series": series, "accuracy": result.accuracy,

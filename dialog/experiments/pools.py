@@ -15,14 +15,15 @@ test pool keeps every state.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, replace
-from functools import lru_cache
 
 import numpy as np
 
 from bullet_world.catalogue import Task, load_task
 from bullet_world.datasets import Pool, load_datasets
 from bullet_world.scene import Scene, SceneTruth
+from learning.errors import SettingsError
 
 PLAN_OPTIONS = ("pool_size", "test_size", "objects_per_scene")
 
@@ -36,23 +37,46 @@ class PoolSet:
     task: Task
 
 
-@lru_cache(maxsize=4)
-def load_pools(task: str, kitchen: str, datasets: int, plan_options: tuple = ()) -> PoolSet:
+# progress(done, total, message): called after each pool is rendered (never when the pools come from the cache)
+RenderProgress = Callable[[int, int, str], None]
+KEPT_POOL_SETS = 4  # pool sets kept in memory per process
+_loaded: dict[tuple, PoolSet] = {}
+
+
+def load_pools(task: str, kitchen: str, datasets: int, plan_options: tuple = (),
+               progress: RenderProgress | None = None) -> PoolSet:
     """``datasets`` training pools and the test pool, from the cache (rendered once, then reused).
 
     ``plan_options`` ((name, value), ...) overrides the task's data-set plan (``pool_size``,
     ``test_size``, ``objects_per_scene``); accepted names are listed in the error otherwise.
+    ``progress`` hears of every pool rendered on a first run.
     """
+    key = (task, kitchen, int(datasets), tuple(plan_options))
+    if key not in _loaded:
+        while len(_loaded) >= KEPT_POOL_SETS:
+            _loaded.pop(next(iter(_loaded)))
+        _loaded[key] = _load_pools(*key, progress)
+    return _loaded[key]
+
+
+def _load_pools(task: str, kitchen: str, datasets: int, plan_options: tuple, progress) -> PoolSet:
     from robot import Arm
 
     loaded = load_task(task)
     options = dict(plan_options)
     unknown = sorted(set(options) - set(PLAN_OPTIONS))
     if unknown:
-        raise ValueError(f"unknown data-set options {unknown}; accepted: {', '.join(PLAN_OPTIONS)}")
+        raise SettingsError(f"unknown data-set options {unknown}; accepted: {', '.join(PLAN_OPTIONS)}")
     plan = replace(loaded.datasets, **{name: int(value) for name, value in options.items()})
     plan = replace(plan, pools=max(datasets, plan.pools))  # fewer pools reuse the task's cached set
-    sets = load_datasets(task, kitchen, seed=0, plan=plan, robot_factory=Arm)
+    total, rendered = plan.pools + 1, []
+
+    def pool_rendered(message: str) -> None:
+        if progress is not None and message.startswith(f"{task}/{kitchen}: pool "):
+            rendered.append(message)
+            progress(len(rendered), total, message)
+
+    sets = load_datasets(task, kitchen, seed=0, plan=plan, robot_factory=Arm, progress=pool_rendered)
     return PoolSet(sets.train[:datasets], sets.test, loaded)
 
 
@@ -68,7 +92,7 @@ class PoolEnvironment:
         concepts = task.concepts
         missing = sorted(set(concepts) - set(train.concepts.tolist()))
         if missing:
-            raise ValueError(f"training pool has no observations of {missing}")
+            raise SettingsError(f"training pool has no observations of {missing}")
         self.train, self.test = train, test
         self.concepts = tuple(concepts)
         self.feature_names = tuple(train.feature_names)

@@ -6,12 +6,14 @@ import os
 import signal
 import sys
 import threading
+import time
 from collections.abc import Callable
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
 
 from dialog.experiments.episodes import EpisodeSpec, run_episode
 from dialog.experiments.suite import Suite
+from learning.errors import SetupError
 
 
 def episode_specs(suite: Suite, results_dir: Path) -> list[EpisodeSpec]:
@@ -54,7 +56,7 @@ def run_on_ray(specs: list[EpisodeSpec], address: str, progress: bool = True) ->
     try:
         import ray
     except ImportError:
-        raise RuntimeError("--ray needs the optional extra: pip install 'teachbot[ray]'") from None
+        raise SetupError("--ray needs the optional extra: pip install 'teachbot[ray]'") from None
     if address == "local":
         start_local_ray(ray)
     else:
@@ -123,8 +125,8 @@ def _check_token_mode(ray) -> None:
     mode = getattr(getattr(ray, "_raylet", None), "get_authentication_mode", None)
     if mode is None or mode() != ray._raylet.AuthenticationMode.TOKEN:
         ray.shutdown()
-        raise RuntimeError(f"--ray local needs token authentication, which Ray {ray.__version__} does not offer "
-                           "(it came in Ray 2.52): pip install 'ray>=2.52'")
+        raise SetupError(f"--ray local needs token authentication, which Ray {ray.__version__} does not offer "
+                         "(it came in Ray 2.52): pip install 'ray>=2.52'")
 
 
 class _progress:
@@ -149,3 +151,54 @@ class _progress:
     def __exit__(self, *exc) -> None:
         if self.enabled:
             self._bar.stop()
+
+
+class RenderBar:
+    """A progress bar on standard error while data sets are rendered on a first run, with the time so far.
+
+    Use as ``with RenderBar("pack-lunchbox/kitchen-1") as bar: load_pools(..., progress=bar)``: the
+    bar appears with the first pool rendered and shows nothing when the pools come from the cache.
+    """
+
+    def __init__(self, what: str, enabled: bool = True):
+        self.what, self.enabled = what, enabled
+        self._bar = self._task = None
+
+    def __enter__(self) -> RenderBar:
+        self._started = time.perf_counter()
+        return self
+
+    def __call__(self, done: int, total: int, message: str) -> None:
+        if not self.enabled:
+            return
+        if self._bar is None:
+            self._start(total)
+        self._bar.update(self._task, completed=done, description=message.split(": ", 1)[-1])
+
+    def _start(self, total: int) -> None:
+        from rich.console import Console
+        from rich.progress import BarColumn, MofNCompleteColumn, Progress, ProgressColumn, TextColumn
+        from rich.text import Text
+
+        started = self._started
+
+        class SinceStart(ProgressColumn):
+            """Minutes:seconds since the rendering began (before the first pool was done)."""
+
+            def render(self, task) -> Text:
+                seconds = int(time.perf_counter() - started)
+                return Text(f"{seconds // 60}:{seconds % 60:02d}", style="progress.elapsed")
+
+        console = Console(file=sys.stderr)
+        self._bar = Progress(TextColumn(f"rendering the data sets of {self.what} (first run; cached afterwards)"),
+                             BarColumn(), MofNCompleteColumn(), SinceStart(), TextColumn("{task.description}"),
+                             console=console, transient=not console.is_terminal)
+        self._bar.start()
+        self._task = self._bar.add_task("", total=total)
+
+    def __exit__(self, *exc) -> None:
+        if self._bar is not None:
+            self._bar.stop()
+            seconds = time.perf_counter() - self._started
+            print(f"rendered the data sets of {self.what} in {seconds:.0f} s; cached for the next runs",
+                  file=sys.stderr)

@@ -127,7 +127,9 @@ def load_suite(name_or_path: str | Path, known_strategies=None) -> Suite:
 
 def _suite(table: dict, where: str, known_strategies) -> Suite:
     check_keys(table, where, required=("name", "strategies", "checkpoints"), optional=SUITE_FIELDS)
-    kind = text(table, "kind", where, "episodes", choices=KINDS)
+    from dialog.experiments.kinds import kind_names  # the registry imports this module
+
+    kind = text(table, "kind", where, "episodes", choices=kind_names())
     strategies = texts(table, "strategies", where, nonempty=True)
     if known_strategies is not None and kind == "episodes":
         unknown = [s for s in strategies if s not in known_strategies]

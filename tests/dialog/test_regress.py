@@ -144,3 +144,13 @@ def test_stratified_samples_are_balanced_and_disjoint():
     assert not set(first) & set(second)
     with pytest.raises(ValueError, match="free rows of 'a'"):
         srs(concepts, 50, rng)
+
+
+def test_a_strategy_subset_says_which_findings_it_skips(tmp_path, capsys):
+    code = main(["regress", "--suite", str(write_suite(tmp_path)), "--results", str(tmp_path / "out"),
+                 "--workers", "1", "--no-progress", "--strategies", "passive"])
+    assert code == 0
+    out = capsys.readouterr().out
+    assert "f1: skipped: needs active, not among the strategies run (passive)" in out
+    report = (tmp_path / "out" / "report.md").read_text()
+    assert "- f1: passive beats active: skipped, needs active, not among the strategies run (passive)" in report

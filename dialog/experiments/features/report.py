@@ -10,8 +10,10 @@ import numpy as np
 
 from dialog.experiments.analysis import CheckpointSummary, FindingResult, pairwise
 from dialog.experiments.features.study import METHODS, UserModel, run_study
-from dialog.experiments.report import _fmt_p
+from dialog.experiments.figures import pyplot
+from dialog.experiments.report import _fmt_p, findings_summary_line, skipped_findings_lines
 from dialog.experiments.suite import Suite
+from learning.errors import SettingsError
 from learning.significance import mean_and_standard_error
 
 
@@ -24,7 +26,7 @@ def run_feature_suite(suite: Suite, pools) -> list[dict]:
     methods = tuple(s for s in suite.strategies if s in METHODS)
     unknown = [s for s in suite.strategies if s not in METHODS]
     if unknown:
-        raise ValueError(f"suite '{suite.name}': unknown approaches {unknown}; accepted: {', '.join(METHODS)}")
+        raise SettingsError(f"suite '{suite.name}': unknown approaches {unknown}; accepted: {', '.join(METHODS)}")
     return run_study(train[0], test, relevant, sizes=suite.checkpoints, samples=int(options.get("samples", 10)),
                      users=int(options.get("users", 10)), user_model=user, seed=suite.seeds[0], methods=methods)
 
@@ -56,11 +58,7 @@ def feature_summaries(rows: list[dict], suite: Suite) -> list[CheckpointSummary]
 
 def write_feature_report(suite: Suite, rows: list[dict], summaries: list[CheckpointSummary],
                          findings: list[FindingResult], seconds: float, out: Path) -> Path:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    plt = pyplot()
     out.mkdir(parents=True, exist_ok=True)
     with open(out / "runs.csv", "w", newline="") as handle:
         writer = csv.DictWriter(handle, fieldnames=["method", "n", "sample", "user", "accuracy", "features"])
@@ -99,7 +97,7 @@ def write_feature_report(suite: Suite, rows: list[dict], summaries: list[Checkpo
             for c in outcome.comparisons:
                 lines.append(f"| {outcome.finding.id}: {outcome.finding.text} | {c.a} > {c.b} | {c.mean_a:.3f} vs "
                              f"{c.mean_b:.3f} | {c.u:.1f} | {_fmt_p(c.p)} | {'yes' if c.significant else 'no'} |")
-        lines.append("")
+        lines += ["", *skipped_findings_lines(findings), findings_summary_line(findings), ""]
         if suite.analysis:
             lines += [f"Why each finding holds or not, and what differs from the thesis: {suite.analysis}", ""]
     path = out / "report.md"

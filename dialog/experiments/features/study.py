@@ -18,6 +18,7 @@ from sklearn.preprocessing import StandardScaler
 from sklearn.svm import SVC
 
 from bullet_world.datasets import Pool
+from learning.errors import SettingsError
 from learning.features.selection import select_features
 
 COMPUTATIONAL = ("none", "FI", "ES", "ER")
@@ -46,7 +47,7 @@ def srs(concepts: np.ndarray, n: int, rng: np.random.Generator, exclude=()) -> n
         candidates = np.array([r for r in np.nonzero(concepts == label)[0] if r not in excluded])
         count = per_class + (1 if i < extra else 0)
         if len(candidates) < count:
-            raise ValueError(f"the pool has only {len(candidates)} free rows of '{label}', {count} needed")
+            raise SettingsError(f"the pool has only {len(candidates)} free rows of '{label}', {count} needed")
         rows.extend(rng.choice(candidates, size=count, replace=False))
     return np.array(sorted(rows))
 
@@ -104,7 +105,7 @@ def run_study(train: Pool, test: Pool, relevant: set[str], sizes=(12, 100), samp
     """Rows of (method, n, sample, user, accuracy, features) for every approach of table 5.2."""
     unknown = [m for m in methods if m not in METHODS]
     if unknown:
-        raise ValueError(f"unknown feature-selection approaches {unknown}; accepted: {', '.join(METHODS)}")
+        raise SettingsError(f"unknown feature-selection approaches {unknown}; accepted: {', '.join(METHODS)}")
     names = train.feature_names
     rows = []
     root = np.random.SeedSequence(seed)

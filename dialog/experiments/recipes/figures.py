@@ -9,18 +9,11 @@ from pathlib import Path
 
 import numpy as np
 
+from dialog.experiments.figures import pyplot  # noqa: F401  (used by the recipe reports too)
+
 # Objects dashed, locations solid (the object curves often coincide: lighting decides them).
 OBJECT_STYLES = tuple({"linestyle": "--", "marker": m, "markersize": 5, "alpha": 0.8} for m in ("o", "s", "^"))
 LOCATION_STYLES = tuple({"linestyle": "-", "marker": m, "markersize": 3} for m in ("o", "v", "D", "x"))
-
-
-def pyplot():
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
 
 
 def plot_cross_validation(curves: dict[str, dict[str, list[float]]], objects: tuple[str, ...], path: Path,
@@ -37,8 +30,8 @@ def plot_cross_validation(curves: dict[str, dict[str, list[float]]], objects: tu
         axis.set_xlabel("training demonstrations m")
         axis.set_ylim(-0.02, 1.02)
         axis.grid(alpha=0.3)
+        axis.legend(fontsize=7, loc="lower right", title="dashed: objects, solid: locations", title_fontsize=7)
     axes[0][0].set_ylabel("accuracy on held-out demonstrations")
-    axes[0][-1].legend(fontsize=8, loc="lower right")
     figure.tight_layout()
     figure.savefig(path, dpi=110)
     plt.close(figure)
@@ -66,11 +59,10 @@ def plot_transfer(rows: list[dict], test_kitchen: str, path: Path, recipe: str =
         axis.set_title(f"{recipe} tested in {test_kitchen}, {m} demos per training kitchen")
         axis.set_ylim(0, 1.05)
         axis.grid(axis="y", alpha=0.3)
+        axis.legend(loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=min(len(chosen), 7), fontsize=7,
+                    title="trained in (blue: without the test kitchen, red: with it)", title_fontsize=7)
     axes[0][0].set_ylabel("accuracy")
-    handles, labels = axes[0][0].get_legend_handles_labels()
-    figure.legend(handles, labels, loc="lower center", ncol=len(labels), fontsize=8,
-                  title="trained in (blue: without the test kitchen, red: with it)", title_fontsize=8)
-    figure.tight_layout(rect=(0, 0.12, 1, 1))
+    figure.tight_layout()
     figure.savefig(path, dpi=110)
     plt.close(figure)
 

@@ -24,7 +24,7 @@ from dialog.experiments.recipes.figures import (
 )
 from dialog.experiments.recipes.study import varied_thirds
 from dialog.experiments.recipes.suite import RecipeStudy, run_mean
-from dialog.experiments.report import _fmt_p
+from dialog.experiments.report import _fmt_p, skipped_findings_lines
 from dialog.experiments.suite import Suite
 from learning.recipes.format import load_builtin_recipe, recipe_parameters
 from learning.significance import mann_whitney, mean_and_standard_error
@@ -138,9 +138,10 @@ def _findings_table(findings: list[FindingResult]) -> list[str]:
             margin = f" + {f.margin:g}" if f.margin else ""
             lines.append(f"| {f.id}: {f.text} | {f.condition} | {c.a}{margin} > {c.b} | {c.mean_a:.3f} vs "
                          f"{c.mean_b:.3f} | {c.u:.1f} | {_fmt_p(c.p)} | {'yes' if c.significant else 'no'} |")
-    lines += ["", "Summary: " + "; ".join(f"{o.finding.id} {'holds' if o.holds else 'does NOT hold'}"
-                                           for o in findings) + ".", ""]
-    for outcome in (o for o in findings if not o.holds):
+    lines += ["", *skipped_findings_lines(findings), "Summary: " + "; ".join(
+        f"{o.finding.id} {'does NOT hold' if not o.holds and not o.skipped else o.verdict}" for o in findings) + ".",
+        ""]
+    for outcome in (o for o in findings if not o.holds and not o.skipped):
         f = outcome.finding
         for c in outcome.comparisons:
             direction = "higher" if c.mean_a > c.mean_b else "lower" if c.mean_a < c.mean_b else "equal"

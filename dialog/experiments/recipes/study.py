@@ -35,6 +35,7 @@ from dialog.recipe_session import (
     parameter_names,
     recipe_steps,
 )
+from learning.errors import SettingsError
 from learning.recipes.format import Recipe
 from learning.recipes.grounding import DEFAULT_TAU
 from robot import Arm
@@ -69,7 +70,7 @@ def cross_validation_runs(recipe: Recipe, demos: list[RecipeDemonstration], m_va
     n = len(demos)
     bad = [m for m in m_values if not 1 <= m < n]
     if bad:
-        raise ValueError(f"cross-validation needs 1 <= m < n = {n} demonstrations, got m = {bad}")
+        raise SettingsError(f"cross-validation needs 1 <= m < n = {n} demonstrations, got m = {bad}")
     runs = []
     for m in m_values:
         for repeat in range(repeats):

@@ -304,15 +304,16 @@ def evaluate_recipe_findings(summaries: list[CheckpointSummary], suite: Suite) -
     lookup = {(s.condition, s.strategy): s for s in summaries}
     outcomes = []
     for finding in suite.findings:
-        better = _column(lookup, finding.condition, finding.better, finding.at)
-        if better is None:
+        than_at = finding.than_at or finding.at
+        arms = [(finding.better, finding.at), *((other, than_at) for other in finding.than)]
+        missing = [f"{arm} at m = {m}" for arm, m in arms if _column(lookup, finding.condition, arm, m) is None]
+        if missing:
+            outcomes.append(FindingResult(finding, (), f"no trials of {', '.join(missing)} in {finding.condition}"))
             continue
+        better = _column(lookup, finding.condition, finding.better, finding.at)
         comparisons = []
         for other in finding.than:
-            than_at = finding.than_at or finding.at
             values = _column(lookup, finding.condition, other, than_at)
-            if values is None:
-                continue
             test = mann_whitney(f"{finding.better} m={finding.at}", better + finding.margin,
                                 f"{other} m={than_at}", values, finding.alternative)
             comparisons.append(replace(test, mean_a=float(np.mean(better))))

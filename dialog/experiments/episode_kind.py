@@ -1,0 +1,50 @@
+"""The episodes kind: every (condition, strategy, data set, seed) as one scripted-teacher episode (ch. 6, 7)."""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+from dialog.experiments.analysis import evaluate_findings, summarise
+from dialog.experiments.figures import save_figures
+from dialog.experiments.kinds import RunOptions, SuiteKind, SuiteRun, register_kind
+from dialog.experiments.pools import load_pools
+from dialog.experiments.report import markdown_report, write_episode_csvs
+from dialog.experiments.runner import RenderBar, episode_specs, run_locally, run_on_ray
+from dialog.experiments.suite import Suite, SuiteError
+from learning.strategies import STRATEGY_NAMES
+
+
+@register_kind
+class EpisodesKind(SuiteKind):
+    name = "episodes"
+
+    def load(self, suite: Suite) -> Suite:
+        where = suite.path or suite.name
+        unknown = [s for s in suite.strategies if s not in STRATEGY_NAMES]
+        if unknown:
+            raise SuiteError(f"{where}: unknown strategies {unknown}; choose from: {', '.join(STRATEGY_NAMES)}")
+        for finding in suite.findings:
+            if finding.at not in suite.checkpoints:
+                raise SuiteError(f"{where}: finding '{finding.id}' compares at {finding.at}, which is not one of "
+                                 f"the checkpoints {list(suite.checkpoints)}")
+        return suite
+
+    def run(self, suite: Suite, options: RunOptions) -> SuiteRun:
+        started = time.perf_counter()
+        with RenderBar(f"{suite.task}/{suite.kitchen}", options.progress) as bar:  # once, before the workers
+            load_pools(suite.task, suite.kitchen, suite.datasets, suite.plan_options, progress=bar)
+        specs = episode_specs(suite, options.results)
+        if options.ray:
+            results = run_on_ray(specs, options.ray, options.progress)
+        else:
+            results = run_locally(specs, options.workers, options.progress)
+        summaries = summarise(results, suite)
+        return SuiteRun(suite, results, summaries, evaluate_findings(summaries, suite), len(results),
+                        time.perf_counter() - started)
+
+    def report(self, run: SuiteRun, folder: Path) -> list[Path]:
+        table = write_episode_csvs(run.data, folder)
+        figures = save_figures(run.data, run.suite, folder)
+        report = markdown_report(run.suite, run.data, run.summaries, run.findings, run.seconds, folder, figures)
+        return [report, table, *figures]

@@ -1,0 +1,117 @@
+"""Suite kinds behind one small interface, registered by name.
+
+A suite file's ``kind`` picks one of the registered kinds; ``teachbot regress``
+asks the registry for it and calls the same four steps on every kind:
+
+    kind = get_kind(suite.kind)
+    suite = kind.load(suite)                  # the kind's own checks, before anything runs
+    run = kind.run(suite, RunOptions(...))    # results, summaries at checkpoints, finding tests
+    paths = kind.report(run, folder)          # report.md first, then CSV files and figures
+    problems = kind.check(run, baseline)      # readable differences from the stored baseline
+
+The built-in kinds (episodes, feature-selection, recipes) register when first
+asked for; another kind registers with ``register_kind``.
+"""
+
+from __future__ import annotations
+
+import importlib
+from abc import ABC, abstractmethod
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, ClassVar
+
+from dialog.experiments.analysis import CheckpointSummary, FindingResult, skipped_by_overrides
+from dialog.experiments.baseline import check_against_baseline
+from dialog.experiments.suite import Suite, SuiteError
+
+BUILTIN_KIND_MODULES = ("dialog.experiments.episode_kind", "dialog.experiments.features.kind",
+                        "dialog.experiments.recipes.kind")
+
+
+@dataclass(frozen=True)
+class RunOptions:
+    """How to run a suite: where its files go, worker processes, a Ray cluster, a progress bar."""
+
+    results: Path
+    workers: int | None = None
+    ray: str | None = None
+    progress: bool = True
+
+
+@dataclass
+class SuiteRun:
+    """What one run of a suite produced; ``data`` is the kind's own results (episodes, rows, trials)."""
+
+    suite: Suite
+    data: Any
+    summaries: list[CheckpointSummary]
+    findings: list[FindingResult]
+    count: int
+    seconds: float
+    extra: dict = field(default_factory=dict)  # kind-specific context the report needs (e.g. a recipe study)
+
+
+class SuiteKind(ABC):
+    """One kind of suite: load (check), run, report, check against a baseline."""
+
+    name: ClassVar[str]
+
+    def load(self, suite: Suite) -> Suite:
+        """Check what only this kind knows about the suite; raise ``SuiteError`` naming the file."""
+        return suite
+
+    @abstractmethod
+    def run(self, suite: Suite, options: RunOptions) -> SuiteRun:
+        """Run every trial of the suite; summaries and finding tests included."""
+
+    @abstractmethod
+    def report(self, run: SuiteRun, folder: Path) -> list[Path]:
+        """Write the report (first path), its tables and figures into ``folder``."""
+
+    def check(self, run: SuiteRun, baseline: Path | None = None) -> list[str]:
+        """Readable differences from the stored baseline bands (empty: every mean is inside)."""
+        return check_against_baseline(run.suite, run.summaries, baseline)
+
+
+_KINDS: dict[str, SuiteKind] = {}
+
+
+def register_kind(kind: type[SuiteKind]) -> type[SuiteKind]:
+    """Register a ``SuiteKind`` subclass under its ``name`` (usable as a class decorator)."""
+    name = getattr(kind, "name", "")
+    if not isinstance(name, str) or not name:
+        raise TypeError(f"{kind.__name__} needs a non-empty class attribute 'name'")
+    if name in _KINDS and type(_KINDS[name]) is not kind:
+        raise ValueError(f"a suite kind named '{name}' is already registered ({type(_KINDS[name]).__name__})")
+    _KINDS[name] = kind()
+    return kind
+
+
+def _load_builtin_kinds() -> None:
+    for module in BUILTIN_KIND_MODULES:
+        importlib.import_module(module)
+
+
+def kind_names() -> tuple[str, ...]:
+    """The registered kinds, built-in ones first."""
+    _load_builtin_kinds()
+    return tuple(_KINDS)
+
+
+def get_kind(name: str) -> SuiteKind:
+    """The registered kind called ``name``; an unknown name is one message listing the registered kinds."""
+    names = kind_names()
+    if name not in _KINDS:
+        raise SuiteError(f"unknown suite kind '{name}'; registered kinds: {', '.join(names)}")
+    return _KINDS[name]
+
+
+def run_suite(kind: SuiteKind, suite: Suite, options: RunOptions, original: Suite | None = None) -> SuiteRun:
+    """Run ``suite`` with ``kind``; findings of ``original`` that a strategy subset left out come back skipped."""
+    run = kind.run(suite, options)
+    if original is not None:
+        order = {finding.id: index for index, finding in enumerate(original.findings)}
+        run.findings = sorted([*run.findings, *skipped_by_overrides(original, suite)],
+                              key=lambda outcome: order.get(outcome.finding.id, len(order)))
+    return run
