@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
+from bullet_world.viewpoint import Viewpoint
 from learning.datafiles import check_keys, number, read_toml, tables, text
 from learning.errors import DataFileError
 
@@ -24,7 +25,12 @@ LONG_ASPECT = 1.7       # at least this: long
 FLAT_RATIO = 0.45       # height / width at most this: flat
 TALL_RATIO = 1.4        # height / length at least this: tall
 NEAR_METRES = 0.2       # farther from every location: the area of the counter ("at the front left")
+SIDE_METRES = 0.12      # this far to the teacher's left or right of the work area's middle: "left", "right"
+DEPTH_METRES = 0.10     # this far towards the teacher (front) or the robot (back)
 SURFACES = ("counter", "table", "worktop")
+# Transcripts written before the teacher's viewpoint used fixed world sides (front: y < -0.08, left: x < -0.12):
+# the same words from a viewer facing +y, whose middle is y = 0.02. Replays accept them.
+OLD_WORLD_VIEWPOINT = Viewpoint(facing=(0.0, 1.0), centre=(0.0, 0.02))
 
 
 @lru_cache(maxsize=2)
@@ -91,18 +97,20 @@ def shape_words(length: float, width: float, height: float) -> list[str]:
     return cues
 
 
-def area_phrase(xy) -> str:
-    """Where on the counter, as the robot (and a person behind it) sees it: front is near the robot."""
-    x, y = float(xy[0]), float(xy[1])
-    depth = "front" if y < -0.08 else "back" if y > 0.12 else "middle"
-    side = "left" if x < -0.12 else "right" if x > 0.12 else ""
+def area_phrase(xy, viewpoint: Viewpoint | None = None) -> str:
+    """Where on the counter, as the teacher across the counter sees it: front is the teacher's side, back the
+    robot's, left the teacher's left (see :mod:`bullet_world.viewpoint`)."""
+    right, towards_teacher = (viewpoint or Viewpoint()).sides(xy)[0]
+    depth = "front" if towards_teacher > DEPTH_METRES else "back" if towards_teacher < -DEPTH_METRES else "middle"
+    side = "right" if right > SIDE_METRES else "left" if right < -SIDE_METRES else ""
     if depth == "middle":
         return f"on the {side}" if side else "in the middle"
     return f"at the {depth} {side}".rstrip() if side else f"at the {depth}"
 
 
-def place_phrase(xy, locations: dict) -> str:
-    """"at the stove" inside a location's region, "near the fridge" close to one, else the area of the counter.
+def place_phrase(xy, locations: dict, viewpoint: Viewpoint | None = None) -> str:
+    """"at the stove" inside a location's region, "near the fridge" close to one, else the area of the counter
+    seen from ``viewpoint`` (the teacher's; a teacher at +y facing -y when not given).
 
     Work surfaces (the counter itself) hold everything, so they name no place.
     """
@@ -117,7 +125,7 @@ def place_phrase(xy, locations: dict) -> str:
         name, distance = min(((n, float(np.linalg.norm(xy - c))) for n, c in centres.items()), key=lambda p: p[1])
         if distance <= NEAR_METRES:
             return f"near the {name}"
-    return area_phrase(xy)
+    return area_phrase(xy, viewpoint)
 
 
 def _column(scene, candidates) -> np.ndarray | None:
@@ -130,9 +138,10 @@ def _column(scene, candidates) -> np.ndarray | None:
 class SceneDescriber:
     """Descriptions and a short table of one scene's objects, numbered from 1."""
 
-    def __init__(self, scene, locations: dict | None = None):
+    def __init__(self, scene, locations: dict | None = None, viewpoint: Viewpoint | None = None):
         self.scene = scene
         self.locations = locations or {}
+        self.viewpoint = viewpoint or Viewpoint()
         n = scene.n_objects
         sizes = [_column(scene, SIZE_FEATURES[k]) for k in ("length", "width", "height")]
         self.sizes = np.column_stack(sizes) if all(s is not None for s in sizes) else None
@@ -141,7 +150,7 @@ class SceneDescriber:
         self.colour_names = [colour_name(c) if has_colour else "" for c in self.colours]
         positions = np.asarray(scene.positions, dtype=float).reshape(n, -1) if n else np.zeros((0, 3))
         placed = positions.shape[1] >= 2 and bool(np.any(positions[:, :2] != 0))
-        self.places = [place_phrase(p, self.locations) if placed else "" for p in positions]
+        self.places = [place_phrase(p, self.locations, self.viewpoint) if placed else "" for p in positions]
         volumes = np.prod(self.sizes, axis=1) if self.sizes is not None else np.zeros(0)
         if n >= 3 and len(volumes) and np.ptp(volumes) > 0:  # small and big only compared with the rest
             low, high = np.quantile(volumes, [0.25, 0.75])

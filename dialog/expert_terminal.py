@@ -19,8 +19,41 @@ from learning.actions import Action, DemoQuery, FeatureQuery, LabelQuery, NoQuer
 from learning.decision.features import label_distribution
 
 SHORT_NAMES = ("ACD", "CDU", "IV", "PM", "budget", "time", "quiet")  # FEATURE_NAMES order
-HELP = ("Type one of: LQ <object number> (or just the number), DQ <concept name or number>, FSQ, none, "
-        "table (the scene again), help, quit.")
+COLUMN_MEANINGS = {  # what each column of the candidates table says, in words (thesis §6.4.2, §7.3.1)
+    "command": "what to type to ask this question",
+    "question": "the question in words",
+    "robot's guess": "the concept the robot thinks the object is, and how sure it is (no guess yet: all tied)",
+    "cost": "budget units this question spends",
+    "ACD": "classifier discriminability: how well the concept models tell this scene's objects apart",
+    "CDU": "class-distribution uniformity: how evenly the examples so far spread over the concepts",
+    "IV": "instance variation: how much the objects of the scene differ in what the robot predicts",
+    "PM": "prediction margin: how far ahead each object's best concept is of the second best",
+    "budget": "budget consumption: the fraction of the question budget spent",
+    "time": "remaining time: the fraction of the turns still to come",
+    "quiet": "non-query time: how long the robot has stayed quiet (1 after a whole window of silence)",
+}
+COMMANDS = ("Type one of: LQ <object number> (or just the number), DQ <concept name or number>, FSQ, none, "
+            "table (the scene again), help, quit.")
+HELP = COMMANDS  # the short form, repeated after a command that cannot be taken
+TIE_MARGIN = 1e-6  # the top concepts closer than this: the robot has no guess yet
+TABLE_KEY = ("ACD discriminability · CDU class uniformity · IV instance variation · PM prediction margin · "
+             "budget spent · time left · quiet time; 'help' explains each")
+
+
+def help_text() -> str:
+    """The commands, and every column of the candidates table explained."""
+    lines = [COMMANDS, "Columns (query rows show each feature's expected change against staying quiet; "
+                       "all features lie in 0..1):"]
+    lines += [f"  {name:<14} {meaning}" for name, meaning in COLUMN_MEANINGS.items()]
+    return "\n".join(lines)
+
+
+def guess_text(probabilities, concepts) -> str:
+    """"fruit 0.62" for one object's concept distribution, or "no guess yet" when the top concepts tie."""
+    order = sorted(range(len(concepts)), key=lambda i: -float(probabilities[i]))
+    if len(order) > 1 and float(probabilities[order[0]]) - float(probabilities[order[1]]) <= TIE_MARGIN:
+        return "no guess yet"
+    return f"{concepts[order[0]]} {float(probabilities[order[0]]):.2f}"
 
 
 class ExpertInputError(ValueError):
@@ -81,11 +114,12 @@ class PersonChooser:
 
     name = "person"
 
-    def __init__(self, input_stream=None, output_stream=None, locations: dict | None = None):
+    def __init__(self, input_stream=None, output_stream=None, locations: dict | None = None, viewpoint=None):
         self.reader = LineReader(input_stream if input_stream is not None else sys.stdin)
         self.console = Console(file=output_stream if output_stream is not None else sys.stdout, highlight=False,
                                markup=False, emoji=False, soft_wrap=False, width=160)
         self.locations = locations or {}
+        self.viewpoint = viewpoint  # the teacher's (left, right, front, back in the object descriptions)
         self.scene = None
 
     def say(self, text: str) -> None:
@@ -97,7 +131,7 @@ class PersonChooser:
 
     def show_scene(self) -> None:
         if self.scene is not None:
-            for line in SceneDescriber(self.scene, self.locations).table_lines():
+            for line in SceneDescriber(self.scene, self.locations, self.viewpoint).table_lines():
                 self.console.print(f"  {line}")
 
     def table(self, view: ExpertView) -> Table:
@@ -106,18 +140,17 @@ class PersonChooser:
         candidates, state = view.candidates, view.state
         table = Table(title=f"Turn {view.turn} of {state.turns} · budget left {state.remaining_budget:g} of "
                             f"{state.budget:g} · query rows: change of E[phi] against staying quiet",
-                      title_justify="left", pad_edge=False)
-        for column in ("type", "action", "robot's guess", "cost", *SHORT_NAMES):
+                      caption=TABLE_KEY, caption_justify="left", title_justify="left", pad_edge=False)
+        for column in COLUMN_MEANINGS:
             table.add_column(column, justify="right" if column in ("cost", *SHORT_NAMES) else "left")
         quiet = candidates.expected[candidates.no_query_index]
         Q = label_distribution(state.probabilities()) if len(state.scene_X) else None
-        describer = SceneDescriber(self.scene, self.locations) if self.scene is not None else None
+        describer = SceneDescriber(self.scene, self.locations, self.viewpoint) if self.scene is not None else None
         for row, action in zip(candidates.expected, candidates.actions):
             guess = ""
             if action.kind == "label":
                 command = f"LQ {action.object_index + 1}"
-                top = int(Q[action.object_index].argmax())
-                guess = f"{state.concepts[top]} {Q[action.object_index, top]:.2f}"
+                guess = guess_text(Q[action.object_index], state.concepts)
                 what = describer.describe(action.object_index) if describer else action_label(action)
             elif action.kind == "demo":
                 command, what = f"DQ {action.concept}", f"show me a {action.concept}"
@@ -145,7 +178,7 @@ class PersonChooser:
                 self.console.print(str(error))
                 continue
             if choice == "help":
-                self.console.print(HELP)
+                self.console.print(help_text())
             elif choice == "table":
                 self.show_scene()
                 self.console.print(self.table(view))

@@ -1,4 +1,5 @@
-"""Numbered scene pictures: the camera image with each object's number drawn at its perceived position."""
+"""Numbered scene pictures: the camera image, turned to the teacher's view, with each object's number drawn at
+its perceived position and the kitchen's locations outlined and named."""
 
 from __future__ import annotations
 
@@ -8,10 +9,13 @@ from pathlib import Path
 import cv2
 import numpy as np
 
+from bullet_world.annotate import outlined_text
 from dialog.output_paths import writing
+from learning.errors import OutputPathError
 
 RING_BGR = (0, 215, 255)     # the object the robot asks about
 LABEL_BGR = (255, 255, 255)
+REGION_BGR = (255, 220, 40)  # the kitchen's locations (stove, fridge, pantry, cupboard)
 OUTLINE_BGR = (0, 0, 0)
 
 
@@ -26,23 +30,29 @@ def project_points(points, view_matrix, projection_matrix, width: int, height: i
     return np.column_stack([columns, rows])
 
 
-def annotate_scene(rgb: np.ndarray, pixels, numbers, highlight: int | None = None) -> np.ndarray:
-    """A BGR copy of ``rgb`` with ``numbers[i]`` written at ``pixels[i]``; ``highlight`` (an index) is ringed."""
+def annotate_scene(rgb: np.ndarray, pixels, numbers, highlight: int | None = None,
+                   regions: dict | None = None) -> np.ndarray:
+    """A BGR copy of ``rgb`` with ``numbers[i]`` written (outlined, readable on any colour) at ``pixels[i]``;
+    ``highlight`` (an index) is ringed; ``regions`` (name: corner pixels (4, 2)) are outlined and named."""
     image = cv2.cvtColor(np.ascontiguousarray(rgb, dtype=np.uint8), cv2.COLOR_RGB2BGR)
     height, width = image.shape[:2]
     scale = max(0.45, width / 900.0)
+    for name, corners in (regions or {}).items():
+        corners = np.asarray(corners, dtype=float)
+        cv2.polylines(image, [np.round(corners).astype(np.int32)], True, REGION_BGR, 2, cv2.LINE_AA)
+        (_, text_h), _ = cv2.getTextSize(name, cv2.FONT_HERSHEY_SIMPLEX, 0.6 * scale, 1)
+        top_left = corners.min(axis=0)
+        outlined_text(image, name, (top_left[0] + 4, top_left[1] + text_h + 5), 0.6 * scale, REGION_BGR,
+                      anchor="corner")
     for index, ((column, row), number) in enumerate(zip(np.asarray(pixels, dtype=float), numbers)):
         if not (np.isfinite(column) and np.isfinite(row)):
             continue
         centre = (int(round(np.clip(column, 0, width - 1))), int(round(np.clip(row, 0, height - 1))))
         if index == highlight:
-            cv2.circle(image, centre, int(22 * scale / 0.7), RING_BGR, 3, cv2.LINE_AA)
-        text = str(number)
-        (text_w, text_h), _ = cv2.getTextSize(text, cv2.FONT_HERSHEY_SIMPLEX, scale, 2)
-        origin = (centre[0] - text_w // 2, centre[1] + text_h // 2)
-        cv2.putText(image, text, origin, cv2.FONT_HERSHEY_SIMPLEX, scale, OUTLINE_BGR, 4, cv2.LINE_AA)
-        cv2.putText(image, text, origin, cv2.FONT_HERSHEY_SIMPLEX, scale,
-                    RING_BGR if index == highlight else LABEL_BGR, 2, cv2.LINE_AA)
+            radius = int(22 * scale / 0.7)
+            cv2.circle(image, centre, radius, OUTLINE_BGR, 7, cv2.LINE_AA)
+            cv2.circle(image, centre, radius, RING_BGR, 3, cv2.LINE_AA)
+        outlined_text(image, str(number), centre, scale, RING_BGR if index == highlight else LABEL_BGR, 2)
     return image
 
 
@@ -51,7 +61,7 @@ def save_picture(path: str | Path, bgr: np.ndarray) -> Path:
     path = Path(path)
     encoded, png = cv2.imencode(".png", bgr, [cv2.IMWRITE_PNG_COMPRESSION, 3])
     if not encoded:
-        raise RuntimeError(f"OpenCV could not encode the scene picture {path} as PNG")
+        raise OutputPathError(f"{path}: OpenCV could not encode the scene picture {path} as PNG")
     with writing(path, "scene picture"):
         path.parent.mkdir(parents=True, exist_ok=True)
         try:

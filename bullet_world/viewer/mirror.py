@@ -29,6 +29,8 @@ from bullet_world.viewer.scene import Frame, Look, WorldReader, translation
 from bullet_world.viewer.server import ViewerError
 from bullet_world.viewer.tap import add_step_listener, remove_step_listener
 from bullet_world.viewer.thread import MeshcatThread
+from bullet_world.viewpoint import Viewpoint
+from learning.errors import SettingsError
 
 DWELL_S = {"scene": 1.0, "question": 1.2, "answer": 1.8, "quiet": 0.6}  # pauses in the recording's time
 ASKED_RGBA = (1.0, 0.82, 0.0, 0.35)
@@ -40,14 +42,20 @@ LINE_CHARS, MAX_LINES = 56, 3
 
 
 def default_camera(world) -> tuple[np.ndarray, np.ndarray]:
-    """Eye and target looking at the counter from the teacher's side (across the counter from the robot)."""
+    """Eye and target of the teacher's view (:mod:`bullet_world.viewpoint`): across the counter from the robot,
+    facing it, so the screen's left is the teacher's left, as in the questions' words and the scene pictures."""
     low, high = _counter_box(world)
     centre = np.array([(low[0] + high[0]) / 2, (low[1] + high[1]) / 2, high[2]])
-    direction = centre[:2] - _robot_xy(world, centre)
-    norm = float(np.linalg.norm(direction))
-    direction = direction / norm if norm > 1e-6 else np.array([0.0, 1.0])
-    target = centre + np.array([*(-0.05 * direction), 0.1])
-    return target + np.array([*(1.0 * direction), 0.75]), target
+    kitchen = getattr(world, "kitchen", None)
+    if kitchen is not None and hasattr(kitchen, "robot_yaw"):
+        viewpoint = Viewpoint.of_kitchen(kitchen)
+    else:  # a bare world: face wherever the robot stands
+        facing = _robot_xy(world, centre) - centre[:2]
+        norm = float(np.linalg.norm(facing))
+        facing = facing / norm if norm > 1e-6 else np.array([0.0, -1.0])
+        viewpoint = Viewpoint((float(facing[0]), float(facing[1])), (float(centre[0]), float(centre[1])))
+    target = centre + np.array([*(0.05 * np.asarray(viewpoint.facing)), 0.1])
+    return viewpoint.eye(target, distance=1.0, height=0.75), target
 
 
 def _counter_box(world) -> tuple[np.ndarray, np.ndarray]:
@@ -107,7 +115,7 @@ class Viewer:
                  camera: tuple | None = None, appearance=None, fps: int = 20, live_fps: float = 30.0,
                  start_timeout_s: float = 20.0, reply_timeout_s: float = 10.0):
         if fps < 1 or live_fps <= 0:
-            raise ValueError(f"the viewer needs fps >= 1 and live_fps > 0, got fps={fps}, live_fps={live_fps}")
+            raise SettingsError(f"the viewer needs fps >= 1 and live_fps > 0, got fps={fps}, live_fps={live_fps}")
         self.world, self.client = world, world.client
         self.reader = WorldReader(world, appearance)
         self.camera = camera if camera is not None else default_camera(world)

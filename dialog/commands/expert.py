@@ -8,6 +8,7 @@ import sys
 from pathlib import Path
 
 from dialog.commands._arguments import budget, positive_int
+from dialog.expert import ExpertSettings
 from learning.actions import DEFAULT_COSTS
 
 COST_NAMES = {"lq": "label", "label": "label", "dq": "demo", "demo": "demo", "fsq": "feature", "feature": "feature",
@@ -31,15 +32,22 @@ def register(commands) -> None:
         "expert", help="play the robot's questioner: pick its questions; the turns become IRL demonstrations",
         description="Each turn shows the scene and every candidate question with its cost and its seven expected "
                     "decision features; you pick one (LQ 4, DQ fruit, FSQ, none; help, quit) and a scripted teacher "
-                    "answers. Defaults are the thesis's training condition (§7.4.1).")
-    parser.add_argument("--task", default="prepare-lunch", help="task (default prepare-lunch)")
-    parser.add_argument("--kitchen", default="kitchen-1", help="kitchen (default kitchen-1)")
-    parser.add_argument("--budget", type=budget, default=15.0, help="query budget (default 15)")
-    parser.add_argument("--turns", type=positive_int, default=30, help="turns (default 30)")
-    parser.add_argument("--change-every", type=positive_int, default=10, help="a new scene every r turns (default 10)")
-    parser.add_argument("--costs", type=costs, default=dict(DEFAULT_COSTS), metavar="DQ=2,FSQ=2,LQ=1,NQ=0",
+                    "answers. The feature columns: ACD classifier discriminability, CDU class-distribution "
+                    "uniformity, IV instance variation, PM prediction margin, budget (fraction spent), time "
+                    "(fraction of turns left), quiet (time since the last question); 'help' in a session explains "
+                    "each. Defaults are the thesis's training condition (§7.4.1).")
+    defaults = ExpertSettings()
+    parser.add_argument("--task", default=defaults.task, help=f"task (default {defaults.task})")
+    parser.add_argument("--kitchen", default=defaults.kitchen, help=f"kitchen (default {defaults.kitchen})")
+    parser.add_argument("--budget", type=budget, default=defaults.budget,
+                        help=f"query budget (default {defaults.budget:g})")
+    parser.add_argument("--turns", type=positive_int, default=defaults.turns, help=f"turns (default {defaults.turns})")
+    parser.add_argument("--change-every", type=positive_int, default=defaults.change_every,
+                        help=f"a new scene every r turns (default {defaults.change_every})")
+    parser.add_argument("--costs", type=costs, default=dict(defaults.costs), metavar="DQ=2,FSQ=2,LQ=1,NQ=0",
                         help="query costs (default DQ 2, FSQ 2, LQ 1, NQ 0)")
-    parser.add_argument("--seed", type=int, default=0, help="one seed for every random choice (default 0)")
+    parser.add_argument("--seed", type=int, default=defaults.seed,
+                        help=f"one seed for every random choice (default {defaults.seed})")
     parser.add_argument("--out", type=Path, default=Path("runs") / "expert", metavar="DIR",
                         help="directory for the demonstration (.json) and the transcript (.jsonl)")
     parser.add_argument("--expert", choices=("person", "scripted"), default="person",
@@ -50,7 +58,7 @@ def register(commands) -> None:
 
 def run(args: argparse.Namespace, input_stream=None, output_stream=None) -> int:
     from dialog.environment import SimulatedKitchen
-    from dialog.expert import ExpertQuit, ExpertSettings, output_paths, run_expert_episode
+    from dialog.expert import ExpertQuit, output_paths, run_expert_episode
     from dialog.expert_terminal import PersonChooser
     from dialog.scripted_expert import ScriptedExpertChooser
 
@@ -63,7 +71,7 @@ def run(args: argparse.Namespace, input_stream=None, output_stream=None) -> int:
     environment = SimulatedKitchen(task=settings.task, kitchen=settings.kitchen, seed=settings.seed)
     try:
         if args.expert == "person":
-            chooser = PersonChooser(input_stream, out, environment.locations)
+            chooser = PersonChooser(input_stream, out, environment.locations, environment.viewpoint)
             say, observers = chooser.say, (chooser,)
             say(f"Expert mode: '{settings.task}' ({', '.join(environment.concepts)}) in {settings.kitchen}, "
                 f"{settings.turns} turns, budget {settings.budget:g}, a new scene every {settings.change_every}. "

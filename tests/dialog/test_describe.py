@@ -41,7 +41,7 @@ def test_places_name_the_nearest_location_but_never_the_counter():
     assert place_phrase((-0.42, 0.15), LOCATIONS) == "at the fridge"
     assert place_phrase((0.22, 0.12), LOCATIONS) == "near the stove"
     assert place_phrase((0.0, -0.05), LOCATIONS) == "in the middle"
-    assert place_phrase((-0.2, -0.2), LOCATIONS) == "at the front left"
+    assert place_phrase((-0.2, -0.2), LOCATIONS) == "at the back right"  # seen by the teacher, facing -y
 
 
 def scene_with(colours, sizes, positions):

@@ -70,7 +70,7 @@ def test_the_numbered_picture_rings_the_object_asked_about(kitchen, tmp_path):
     path = kitchen.scene_picture(scene, tmp_path / "p.png", highlight=2)
     image = cv2.imread(str(path))
     assert image.shape[:2] == (kitchen.world.camera.height, kitchen.world.camera.width)
-    _, _, pixels = kitchen._scene_image
+    _, _, pixels, _ = kitchen._scene_image
     column, row = (int(round(v)) for v in pixels[2])
     window = image[max(row - 40, 0):row + 40, max(column - 40, 0):column + 40]
     ring = np.all(np.abs(window.astype(int) - (0, 215, 255)) < 40, axis=2)
