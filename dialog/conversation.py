@@ -10,12 +10,17 @@ are confirmed first. Commands that end the question ("skip", "don't know",
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Literal, get_args
 
 from dialog.parsing import AnswerParser, Reading
 from dialog.questions import Prompt, help_text
+from dialog.teachers import PreParsedTeacher, Teacher
 
 MAX_RECORDED_CHARS = 1000   # a raw line is cut to this length in the transcript
 MAX_LINES_PER_QUESTION = 200  # then the question counts as skipped (a teacher that only sends noise)
+
+OutcomeKind = Literal["answer", "absent", "skip", "dont_know", "undo", "quit", "late", "none"]
+OUTCOME_KINDS: tuple[OutcomeKind, ...] = get_args(OutcomeKind)
 
 
 @dataclass
@@ -27,7 +32,7 @@ class Outcome:
     "late" (answered after the deadline, or not at all), or "none" (no question).
     """
 
-    kind: str
+    kind: OutcomeKind
     value: object = None
     lines: list[str] = field(default_factory=list)
     seconds: float = 0.0
@@ -47,19 +52,10 @@ def read_line(prompt: Prompt, parser: AnswerParser, line: str) -> Reading:
     return prompt.feature_tree.read(line, parser.vocabulary)
 
 
-def _legacy(teacher, prompt: Prompt) -> Outcome:
-    answer = teacher.answer(prompt.action, prompt.text, prompt.scene)
-    value = answer.value
-    if prompt.expects == "feature" and value is not None:
-        value = tuple(int(v) for v in value)
-    kind = "answer" if value is not None else ("absent" if prompt.expects == "demo" else "skip")
-    return Outcome(kind, value, [str(answer.raw)])
-
-
-def converse(teacher, prompt: Prompt, parser: AnswerParser, clock) -> Outcome:
-    """Ask ``prompt`` until it is answered, declined, or time runs out."""
-    if not hasattr(teacher, "listen") and hasattr(teacher, "answer"):
-        return _legacy(teacher, prompt)
+def converse(teacher: Teacher, prompt: Prompt, parser: AnswerParser, clock) -> Outcome:
+    """Ask ``prompt`` until it is answered, declined, or time runs out (``teacher`` as made by ``as_teacher``)."""
+    if isinstance(teacher, PreParsedTeacher):
+        return teacher.outcome(prompt)
     started = clock.now()
     teacher.show(prompt)
     lines: list[str] = []
@@ -75,10 +71,13 @@ def converse(teacher, prompt: Prompt, parser: AnswerParser, clock) -> Outcome:
         if late:
             return Outcome("late", None, lines, now - started)
         reading = parser.choice(line, choices) if choices else read_line(prompt, parser, line)
-        if len(lines) >= MAX_LINES_PER_QUESTION and reading.kind in ("help", "why", "unreadable", "reject", "choose"):
+        if len(lines) >= MAX_LINES_PER_QUESTION and reading.kind in ("help", "why", "more", "unreadable", "reject",
+                                                                    "choose"):
             teacher.tell(f"({len(lines)} answers without one I could take: I'll skip this question.)")
             return Outcome("skip", None, lines, clock.now() - started, "too many unreadable answers")
-        if reading.kind == "help":
+        if reading.kind == "more":  # a group of the feature list opened: a reply, the question stays open
+            teacher.tell(reading.message)
+        elif reading.kind == "help":
             teacher.tell(help_text(prompt) if not choices else
                          "Type the number of the one you meant, or 'no' to answer the question again.")
         elif reading.kind == "why":

@@ -4,6 +4,10 @@ The teacher answers with tree numbers ("1.1, 1.2.3"), ranges ("1.1-1.3"),
 feature or group names ("colour, size"), or "all". A leading "ignore" (or
 "without", "except", ...) names the features to leave out (human feature
 removal, HFR) instead of the ones to use (human feature selection, HFS).
+
+A tree longer than a screen is shown as its groups first (``overview``);
+"more 1.2" (or, then, a group's bare name) opens one group: a reply that lists
+its features, not an answer.
 """
 
 from __future__ import annotations
@@ -16,6 +20,8 @@ from dialog.vocabulary import MAX_ANSWER_CHARS, Vocabulary, clean, load_vocabula
 
 _NUMBER = re.compile(r"^\d{1,3}(\.\d{1,3})*$")
 _PLAIN_WORDS = ("feature", "features", "group", "groups")
+_OPEN_WORDS = ("more", "open", "expand")
+OVERVIEW_LINES = 20  # the feature question's list stays within this many lines
 _RANGE = re.compile(r"^(\d{1,3}(?:\.\d{1,3})*)-(\d{1,3}(?:\.\d{1,3})*)$")
 
 
@@ -91,6 +97,80 @@ class FeatureTree:
     def nodes(self):
         return self.by_number.values()
 
+    @property
+    def collapsed(self) -> bool:
+        """Whether the whole tree is too long for the question, which then lists the groups first."""
+        return len(self.lines()) > OVERVIEW_LINES
+
+    def overview(self, max_lines: int = OVERVIEW_LINES) -> list[str]:
+        """At most ``max_lines`` lines: the whole tree if it fits, else its groups as deep as fit, with counts."""
+        if len(self.lines()) <= max_lines:
+            return self.lines()
+        hint = "(say 'more 1.2' or a group's name to list its features; answer with numbers or names)"
+        levels: dict[int, list[TreeNode]] = {}
+
+        def walk(nodes, depth):
+            for node in nodes:
+                if node.feature is None or depth == 0:
+                    levels.setdefault(depth, []).append(node)
+                    walk(node.children, depth + 1)
+
+        walk(self.roots, 0)
+        depth, shown = 0, len(levels.get(0, []))
+        while depth + 1 in levels and shown + len(levels[depth + 1]) <= max_lines - 1:
+            depth, shown = depth + 1, shown + len(levels[depth + 1])
+        out: list[str] = []
+
+        def show(nodes, level):
+            for node in nodes:
+                if len(out) >= max_lines - 2:
+                    return
+                if node.feature is not None:
+                    if level == 0:
+                        out.append(f"{node.number} {node.name}: {node.description}".rstrip(": "))
+                    continue
+                count = len(node.leaves())
+                text = f"{'  ' * level}{node.number} {node.name}: {count} feature{'s' * (count != 1)}"
+                if level == depth or not any(child.feature is None for child in node.children):
+                    text += f" ({_sample(self.feature_names[i] for i in node.leaves())})"
+                    out.append(text)
+                else:
+                    out.append(text)
+                    show(node.children, level + 1)
+
+        show(self.roots, 0)
+        return [*out, hint]
+
+    def opened(self, node: TreeNode) -> list[str]:
+        """The lines that open one group: its features (and subgroups) with their descriptions."""
+        if node.feature is not None:
+            return [f"{node.number} {node.name}: {node.description}".rstrip(": ")]
+        count = len(node.leaves())
+        lines = [f"{node.number} {node.name}, {count} feature{'s' * (count != 1)} (say '{node.number}' to use "
+                 f"all of them):"]
+
+        def walk(nodes, depth):
+            for child in nodes:
+                text = f"{'  ' * depth}{child.number} {child.name}"
+                if child.feature is not None and child.description:
+                    text += f": {child.description}"
+                lines.append(text)
+                walk(child.children, depth + 1)
+
+        walk(node.children, 1)
+        if len(lines) <= 2 * OVERVIEW_LINES or not any(child.feature is None for child in node.children):
+            return lines
+        lines = lines[:1]  # too long for a screen: its subgroups, each to be opened in turn
+        for child in node.children:
+            if child.feature is not None:
+                lines.append(f"  {child.number} {child.name}: {child.description}".rstrip(": "))
+            else:
+                count = len(child.leaves())
+                lines.append(f"  {child.number} {child.name}: {count} feature{'s' * (count != 1)} "
+                             f"({_sample(self.feature_names[i] for i in child.leaves())})")
+        first = next(child.number for child in node.children if child.feature is None)
+        return [*lines, f"(say 'more {first}' to list one of them)"]
+
     def group_of(self, index: int) -> str:
         """The slash-separated group path of feature ``index``."""
         number = next(n.number for n in self.nodes() if n.feature == index)
@@ -129,12 +209,40 @@ class FeatureTree:
         numbers = [f"{prefix}.{k}" if prefix else str(k) for k in range(int(first[-1]), int(last[-1]) + 1)]
         return [self.by_number[n] for n in numbers if n in self.by_number] or None
 
+    def _open(self, body: str, accepted: str) -> Reading | None:
+        """A "more N" line (or, in a collapsed tree, a bare group name) as a group to list; None for other lines."""
+        target, asked = body.strip(" .:"), False
+        for word in _OPEN_WORDS:
+            if target == word or target.startswith(word + " "):
+                target, asked = target[len(word):].strip(" .:"), True
+                for lead in ("group ", "the "):
+                    target = target[len(lead):] if target.startswith(lead) else target
+                break
+        if _NUMBER.match(target) and target in self.by_number:
+            nodes = [self.by_number[target]] if asked else []
+        else:
+            nodes = self._by_name(target)
+            if not asked and (not self.collapsed or any(node.feature is not None for node in nodes)):
+                nodes = []  # a feature's name, or a name in a tree shown whole, chooses
+        if nodes:
+            lines = [line for node in nodes for line in self.opened(node)]
+            return Reading("more", tuple(node.number for node in nodes), message="\n".join(lines))
+        if asked:
+            shown = f" {target[:30]!r}" if target else ""
+            return Reading("unreadable", message=f"I can't open{shown}: say 'more' and the number (1 to "
+                                                 f"{len(self.roots)}, 1.1, ...) or name of a group. {accepted}")
+        return None
+
     def read(self, text: str, vocabulary: Vocabulary | None = None) -> Reading:
-        """Feature indices to use, from an HFS or HFR answer; unknown items are named, never guessed."""
+        """Feature indices to use, from an HFS or HFR answer; unknown items are named, never guessed.
+
+        "more N" (and, in a collapsed tree, a group's bare name) reads as kind "more": the group's lines.
+        """
         vocabulary = vocabulary or load_vocabulary()
         accepted = ("Give the numbers of the groups or features to use (for example '1.1, 1.2' or '1.1-1.3'), "
-                    "their names, or 'all'; start with 'ignore' to name the ones to leave out instead; or say "
-                    "'don't know', 'skip', 'why', 'undo', 'help' or 'quit'.")
+                    "their names, or 'all'; start with 'ignore' to name the ones to leave out instead; say "
+                    "'more 1.2' to list a group's features; or say 'don't know', 'skip', 'why', 'undo', 'help' or "
+                    "'quit'.")
         if len(text) > MAX_ANSWER_CHARS:
             return Reading("unreadable", message=f"That answer is too long ({len(text)} characters; at most "
                                                  f"{MAX_ANSWER_CHARS}). {accepted}")
@@ -147,6 +255,9 @@ class FeatureTree:
         body = clean(text)
         if not body:
             return Reading("unreadable", message=f"I got an empty answer. {accepted}")
+        opened = self._open(body, accepted)
+        if opened is not None:
+            return opened
         mode = "use"
         for word in vocabulary.ignore_words:
             if body == word or body.startswith(word + " ") or body.startswith(word + ":"):
@@ -191,3 +302,14 @@ class FeatureTree:
             if not selected:
                 return Reading("unreadable", message=f"That would leave no feature to use. {accepted}")
         return Reading("answer", tuple(sorted(selected)), message=f"mode={mode}")
+
+
+def _sample(names, limit: int = 60) -> str:
+    """Feature names joined up to about ``limit`` characters, then "..."."""
+    out, used = [], 0
+    for name in names:
+        if out and used + len(name) + 2 > limit:
+            return ", ".join(out) + ", ..."
+        out.append(name)
+        used += len(name) + 2
+    return ", ".join(out)

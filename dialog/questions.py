@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from dialog.describe import SceneDescriber
+from dialog.environment import KnowsRelevantFeatures, SupportsLocations, SupportsPictures, SupportsViewpoint
 from dialog.feature_tree import FeatureTree
 from learning.actions import Action
 from learning.errors import OutputPathError
@@ -92,7 +93,9 @@ def help_text(prompt: Prompt) -> str:
                 "'none' if there is none here.")
     else:
         body = ("Give tree numbers (1.2 chooses a whole group, 1.2.3 one feature), ranges (1.1-1.3), names "
-                "('colour, size') or 'all'. Start with 'ignore' to list the ones to leave out instead.")
+                "('colour, size') or 'all'. Start with 'ignore' to list the ones to leave out instead. "
+                "'more 1.2' lists the features of group 1.2 (so does a group's name when only the groups are "
+                "shown); 'use 1.2' or '1.2' then chooses it.")
     return f"{body} {COMMON_HELP}"
 
 
@@ -122,6 +125,12 @@ class Questioner:
         self._describer: SceneDescriber | None = None
         self._pictured: set[int] = set()
         self._tabled: set[int] = set()  # scenes whose whole object table the teacher has seen
+        # the environment's optional abilities, checked once
+        self.locations = environment.locations if isinstance(environment, SupportsLocations) else None
+        self.viewpoint = environment.viewpoint if isinstance(environment, SupportsViewpoint) else None
+        self.draws_pictures = isinstance(environment, SupportsPictures)
+        self.relevant_features = (environment.relevant_features if isinstance(environment, KnowsRelevantFeatures)
+                                  else None)
 
     def feature_tree(self) -> FeatureTree:
         if self._tree is None:
@@ -130,13 +139,12 @@ class Questioner:
 
     def describer(self, scene) -> SceneDescriber:
         if self._describer is None or self._describer.scene is not scene:
-            self._describer = SceneDescriber(scene, getattr(self.env, "locations", None))
+            self._describer = SceneDescriber(scene, self.locations, self.viewpoint)
         return self._describer
 
     def picture(self, scene, number: int, highlight: int | None) -> str | None:
         """Path of the numbered picture (``highlight`` ringed), written by the environment; None without one."""
-        draw = getattr(self.env, "scene_picture", None)
-        if self.pictures is None or draw is None:
+        if self.pictures is None or not self.draws_pictures:
             return None
         if highlight is None:
             path = Path(self.pictures) / f"scene-{scene.scene_id:03d}.png"
@@ -146,7 +154,7 @@ class Questioner:
         else:
             path = Path(self.pictures) / f"scene-{scene.scene_id:03d}-turn-{number:03d}-object-{highlight + 1}.png"
         try:
-            return str(draw(scene, path, highlight))
+            return str(self.env.scene_picture(scene, path, highlight))
         except OutputPathError as error:  # pictures are optional: one warning, and the session goes on without
             print(f"warning: {error}; going on without scene pictures", file=sys.stderr, flush=True)
             self.pictures = None
@@ -171,10 +179,10 @@ class Questioner:
             self._tabled.add(scene.scene_id)
         else:
             text = feature_question(self.state.concepts)
-            details = self.feature_tree().lines()
+            details = self.feature_tree().overview()
         if picture:
             details = [f"Picture: {picture}", *details]
         return Prompt(number, self.state.turns, self.state.remaining_budget, action, text, explanation, scene,
                       self.state.concepts, details, picture,
                       self.feature_tree() if action.kind == "feature" else None, description, deadline,
-                      getattr(self.env, "relevant_features", None))
+                      self.relevant_features)

@@ -24,6 +24,7 @@ import numpy as np
 
 from bullet_world.recipes.tracking import match_rows
 from bullet_world.recipes.world import RecipeDemonstration, RecipeObservation, RecipeWorld
+from learning.errors import SettingsError
 from learning.recipes.format import Recipe, RecipeStep, recipe_parameters
 from learning.recipes.grounding import DEFAULT_TAU, ActionObservation, RecipeGrounding, Snapshot
 from learning.recipes.parameter_models import ParameterModel
@@ -40,20 +41,62 @@ HAND_RADIUS_M = 0.035      # the opening fingers sweep about this radius around 
 Narrate = Callable[[str, str, "int | None"], None]
 
 
+DEMO_LIGHTING = ("alternate", "sweep")  # or the name of one lighting condition of the task
+
+
 class NarratedRecipeWorld(RecipeWorld):
     """A ``RecipeWorld`` that tells ``narrate`` (when set) which demonstration the teacher gives.
 
-    It only reports: the demonstrations, their random draws and observations are those of ``RecipeWorld``.
+    ``demo_lighting``: "alternate" (default) turns to the next lighting condition with every arrangement, so
+    that even a few demonstrations see them all; "sweep" keeps ``RecipeWorld``'s order (every arrangement
+    under the first condition, then under the next: the thesis's demonstrations 1-6, 7-12); a condition's
+    name shows every demonstration under it. Arrangements and random draws are those of ``RecipeWorld``.
     """
 
     narrate: Narrate | None = None
+    demo_lighting: str = "alternate"
 
     def demonstrate_once(self, number: int, layout: int, arrangement, lighting: str,
                          rng: np.random.Generator) -> RecipeDemonstration:
+        lighting = demonstration_lighting(self.demo_lighting, list(self.setup.lighting), layout, lighting)
         if self.narrate is not None:
             steps = "; ".join(f"{obj}: {start} -> {end}" for obj, start, end in self.steps)
             self.narrate(f"Teacher: demonstration {number} (arrangement {layout + 1}, {lighting} light)", steps, None)
         return super().demonstrate_once(number, layout, arrangement, lighting, rng)
+
+
+def demonstration_lighting(order: str, conditions: list[str], layout: int, swept: str) -> str:
+    """The lighting of one demonstration: ``swept`` is the condition ``RecipeWorld``'s sweep order gives it."""
+    if order == "sweep":
+        return swept
+    if order == "alternate":  # shifted by the arrangement: each one still meets every condition across sweeps
+        return conditions[(conditions.index(swept) + layout) % len(conditions)]
+    if order not in conditions:
+        raise SettingsError(f"unknown demonstration lighting {order!r}; accepted: "
+                            f"{', '.join([*DEMO_LIGHTING, *conditions])}")
+    return order
+
+
+def check_lighting(conditions, execution: str | None, demonstrations: str = "alternate") -> None:
+    """Refuse a lighting the task does not have (before any work), naming the ones it has."""
+    conditions = list(conditions)
+    if execution is not None and execution not in conditions:
+        raise SettingsError(f"--lighting {execution!r}: the task's lighting conditions are {', '.join(conditions)}")
+    if demonstrations not in (*DEMO_LIGHTING, *conditions):
+        raise SettingsError(f"--demo-lighting {demonstrations!r}: accepted are {', '.join(DEMO_LIGHTING)} or one "
+                            f"of the task's lighting conditions ({', '.join(conditions)})")
+
+
+def lighting_hint(demonstrations: Sequence[RecipeDemonstration], lighting: str, outcomes) -> str | None:
+    """Why an execution may have failed: its lighting is one no demonstration was given in (None otherwise)."""
+    seen = list(dict.fromkeys(demonstration.lighting for demonstration in demonstrations))
+    failed = [outcome for outcome in outcomes if not outcome.success]
+    if not failed or lighting in seen:
+        return None
+    return (f"Hint: the execution ran under {lighting} lighting, but every demonstration was given under "
+            f"{' and '.join(seen)} lighting, so the object models never saw how the objects look under "
+            f"{lighting} light ({len(failed)} of {len(outcomes)} steps failed). Demonstrate under it too "
+            f"(--demo-lighting alternate, the default), or execute under {seen[0]} (--lighting {seen[0]}).")
 
 
 def recipe_steps(recipe: Recipe) -> list[tuple[str, str, str]]:
@@ -254,3 +297,18 @@ def execute_recipe(grounding: RecipeGrounding, recipe: Recipe, recipe_world: Rec
         outcomes.append(StepOutcome(step, status, explanation, kind, role == step.object, in_region, result))
         narrate(f"Robot: {step}", "placed" if result.success else f"{result.reason}: {result.detail}", body)
     return outcomes
+
+
+def execute_in_new_arrangement(grounding: RecipeGrounding, recipe: Recipe, recipe_world: RecipeWorld,
+                               rng: np.random.Generator, grasp: str, lighting: str, tau: float = DEFAULT_TAU,
+                               narrate: Narrate | None = None) -> list[StepOutcome]:
+    """Light the kitchen, lay out a new arrangement and let the Panda carry the recipe out (``teachbot recipe``)."""
+    from robot import Arm
+
+    manipulator = Manipulator(Arm(recipe_world.world), grasp)
+    try:
+        recipe_world.set_lighting(lighting)
+        recipe_world.arrange(recipe_world.new_arrangement(rng))
+        return execute_recipe(grounding, recipe, recipe_world, manipulator, rng, tau, narrate=narrate)
+    finally:
+        manipulator.close()

@@ -82,6 +82,7 @@ class TerminalTeacher:
                                force_terminal=color, no_color=color is False)
         self.clock = clock
         self._missed = False
+        self._shown: Prompt | None = None  # the question on screen: asked again (after undo), not reprinted
 
     def options(self) -> dict:
         return {"kind": "terminal"}
@@ -92,6 +93,9 @@ class TerminalTeacher:
             if dropped:
                 self.say(f"(ignored {dropped} line(s) typed after the time ran out)")
             self._missed = False
+        if prompt is self._shown and prompt.expects == "feature":
+            return  # its list is still on screen, and "Taken back: ..." repeated the question
+        self._shown = prompt
         self.console.print()
         status = f"Turn {prompt.turn} of {prompt.turns} · budget left {prompt.budget_left:g}"
         if prompt.deadline is not None and self.clock is not None:

@@ -8,16 +8,20 @@ Wiring, in a command module::
         result = manager.run()
 
 If the viewer can't start, one warning line goes to standard error and the
-session goes on headless.
+session goes on headless. ``hold_viewer(args, viewer)`` after the summary keeps a
+live viewer up until Enter (in a terminal) or for ``--viewer-hold SECONDS``.
 """
 
 from __future__ import annotations
 
 import argparse
+import os
 import sys
+import time
 from contextlib import contextmanager
 from pathlib import Path
 
+from dialog.commands._arguments import seconds
 from dialog.output_paths import check_writable, from_os_error
 from learning.errors import OutputPathError
 
@@ -30,6 +34,9 @@ def add_viewer_option(parser: argparse.ArgumentParser) -> None:
     group.add_argument("--viewer-export", type=Path, default=None, metavar="HTML",
                        help="write the episode as one static HTML page with meshcat's animation (opens without "
                             "a server)")
+    group.add_argument("--viewer-hold", type=seconds, default=None, metavar="SECONDS",
+                       help="with --viewer: keep the viewer up this long after the end (default: until Enter when "
+                            "run in a terminal, not at all otherwise; 0: close at once)")
 
 
 def start_viewer(args: argparse.Namespace, world):
@@ -49,6 +56,37 @@ def start_viewer(args: argparse.Namespace, world):
     if viewer.url:
         print(f"Viewer: {viewer.url}", file=sys.stderr)
     return viewer
+
+
+def hold_viewer(args: argparse.Namespace, viewer, stdin=None, out=None) -> float:
+    """Keep a live viewer up at the end: until Enter when stdin is a terminal (not under CI), or for
+    ``--viewer-hold`` seconds; Ctrl-C ends the hold. Returns the seconds held."""
+    url = getattr(viewer, "url", None)
+    hold = getattr(args, "viewer_hold", None)
+    stdin, out = stdin or sys.stdin, out or sys.stderr
+    if not url or hold == 0 or (hold is None and not _interactive(stdin)):
+        return 0.0
+    started = time.monotonic()
+    try:
+        if hold is None:
+            print(f"The viewer stays at {url}; press Enter to close it", file=out, flush=True)
+            stdin.readline()
+        else:
+            print(f"The viewer stays at {url} for {hold:g} s (Ctrl-C closes it)", file=out, flush=True)
+            time.sleep(hold)
+    except KeyboardInterrupt:
+        print("", file=out, flush=True)
+    return time.monotonic() - started
+
+
+def _interactive(stream) -> bool:
+    """Whether a person can press Enter on ``stream``: a terminal, and not a CI run."""
+    if os.environ.get("CI"):
+        return False
+    try:
+        return stream.isatty()
+    except (AttributeError, OSError, ValueError):
+        return False
 
 
 def stop_viewer(viewer) -> dict | None:

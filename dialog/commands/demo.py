@@ -8,9 +8,10 @@ from dataclasses import asdict
 from pathlib import Path
 
 from dialog.commands._arguments import add_episode_options
-from dialog.commands._viewer import add_viewer_option, viewer_observers
+from dialog.commands._viewer import add_viewer_option, hold_viewer, viewer_observers
 from dialog.environment import SimulatedKitchen
-from dialog.manager import DialogManager, EpisodeConfig, episode_generators
+from dialog.manager import DialogManager, episode_generators
+from dialog.settings import EpisodeSettings
 from dialog.teachers import OracleTeacher
 from dialog.transcript import FORMAT, TranscriptWriter
 from dialog.transcript_lock import TranscriptLock
@@ -50,7 +51,9 @@ def refuse_foreign_transcript(path: Path, lock: TranscriptLock) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    config = EpisodeConfig(turns=args.turns, budget=args.budget, change_every=args.change_every, seed=args.seed)
+    settings = EpisodeSettings(task=args.task, kitchen=args.kitchen, strategy=args.strategy, seed=args.seed,
+                               turns=args.turns, budget=args.budget, change_every=args.change_every)
+    config = settings.config()
     rngs = episode_generators(args.seed)
     transcript_path = args.transcript or Path("runs") / f"demo-{args.strategy}-seed{args.seed}.jsonl"
     lock = TranscriptLock(transcript_path)  # checked and held before the kitchen is built: one writer per file
@@ -58,20 +61,26 @@ def run(args: argparse.Namespace) -> int:
         refuse_foreign_transcript(transcript_path, lock)
         environment = SimulatedKitchen(task=args.task, kitchen=args.kitchen, seed=args.seed)
         try:
-            with viewer_observers(args, environment.world) as observers, \
-                    TranscriptWriter(transcript_path, lock=lock) as transcript:
-                manager = DialogManager(environment, OracleTeacher(rngs["teacher"]), make_strategy(args.strategy),
-                                        config, transcript, rngs, observers=observers, session={"command": "demo"})
-                result = manager.run()
+            with viewer_observers(args, environment.world) as observers:
+                with TranscriptWriter(transcript_path, lock=lock) as transcript:
+                    manager = DialogManager(environment, OracleTeacher(rngs["teacher"]),
+                                            make_strategy(args.strategy), config, transcript, rngs,
+                                            observers=observers, session={"command": "demo"})
+                    result = manager.run()
+                _print_summary(args, result, environment)
+                hold_viewer(args, observers[0] if observers else None)
         finally:
             environment.close()
     finally:
         lock.release()
+    return 0
+
+
+def _print_summary(args: argparse.Namespace, result, environment) -> None:
     print(f"\nAccuracy on {args.task} held-out scenes: {result.accuracy:.1%} "
           f"(chance {1 / len(environment.concepts):.0%}); budget spent {result.budget_spent:g} of {args.budget:g}; "
-          f"queries {result.queries}; {result.seconds:.1f} s. Transcript: {result.transcript}")
+          f"queries {result.queries}; {result.seconds:.1f} s. Transcript: {result.transcript}", flush=True)
     if args.json:
         summary = {key: asdict(result)[key] for key in SUMMARY_KEYS}
         summary["queries"] = {kind: summary["queries"][kind] for kind in ("label", "demo", "feature", "none")}
-        print(json.dumps(summary))
-    return 0
+        print(json.dumps(summary), flush=True)

@@ -21,21 +21,22 @@ import time
 
 import numpy as np
 
+from bullet_world.recipes.setup import load_recipe_setup
 from dialog.commands._arguments import positive_int
-from dialog.commands._viewer import add_viewer_option, start_viewer, stop_viewer
+from dialog.commands._viewer import add_viewer_option, hold_viewer, start_viewer, stop_viewer
 from dialog.recipe_session import (
     NarratedRecipeWorld,
     StepOutcome,
-    execute_recipe,
+    check_lighting,
+    execute_in_new_arrangement,
     ground,
+    lighting_hint,
     parameter_names,
     recipe_steps,
 )
 from learning.recipes.format import Recipe, builtin_recipe_names, load_builtin_recipe, load_recipe
 from learning.recipes.grounding import DEFAULT_TAU, RecipeGrounding
-from robot import Arm
 from robot.grasping import GRASP_MODES
-from robot.pick_place import Manipulator
 
 CAPTION_DWELL_S = 1.5  # seconds each caption holds in an exported page (--viewer-export)
 
@@ -50,7 +51,12 @@ def register(commands) -> None:
                         help="kitchen name or number (default kitchen-1)")
     parser.add_argument("--demos", type=positive_int, default=5, help="demonstrations to learn from (default 5)")
     parser.add_argument("--execute", action="store_true", help="carry the recipe out with the arm afterwards")
-    parser.add_argument("--lighting", default=None, help="lighting for the execution scene (default: the first)")
+    parser.add_argument("--lighting", default=None,
+                        help="lighting for the execution scene, one of the task's conditions (default: the first)")
+    parser.add_argument("--demo-lighting", default="alternate", metavar="ORDER",
+                        help="lighting of the demonstrations: alternate (default: the next condition with every "
+                             "arrangement), sweep (all arrangements under the first condition, then the next, as "
+                             "in the thesis) or one condition's name")
     parser.add_argument("--grasp", choices=GRASP_MODES, default=GRASP_MODES[0], help="grasp mode (default friction)")
     parser.add_argument("--tau", type=positive_float, default=DEFAULT_TAU,
                         help=f"Mahalanobis threshold (default {DEFAULT_TAU:g})")
@@ -84,20 +90,23 @@ def load_any_recipe(name_or_path: str) -> Recipe:
 def run(args: argparse.Namespace) -> int:
     started = time.perf_counter()
     recipe = load_any_recipe(args.recipe)
+    check_lighting(load_recipe_setup(args.task or recipe.name).lighting, args.lighting, args.demo_lighting)
     rng = np.random.default_rng(args.seed)
     with NarratedRecipeWorld(recipe_steps(recipe), task=args.task or recipe.name, kitchen=args.kitchen,
                              seed=args.seed) as world:
+        world.demo_lighting = args.demo_lighting
         viewer = start_viewer(args, world.world)
         try:
             if viewer is not None:
                 viewer.start_recording()
                 world.narrate = _narrator(viewer, world)
             summary = _session(args, recipe, world, rng, world.narrate)
+            summary["seconds"] = round(time.perf_counter() - started, 1)
+            if args.json:
+                print(json.dumps(summary), flush=True)
+            hold_viewer(args, viewer)
         finally:
             stop_viewer(viewer)
-    summary["seconds"] = round(time.perf_counter() - started, 1)
-    if args.json:
-        print(json.dumps(summary))
     return 0
 
 
@@ -113,15 +122,14 @@ def _session(args: argparse.Namespace, recipe: Recipe, world: NarratedRecipeWorl
     summary = {"recipe": recipe.name, "kitchen": world.kitchen.name, "demos": args.demos, "seed": args.seed,
                "moved_object_found": parsed_right, "parameters": _model_summary(recipe, grounding)}
     if args.execute:
-        manipulator = Manipulator(Arm(world.world), args.grasp)
-        try:
-            world.set_lighting(args.lighting or next(iter(world.setup.lighting)))
-            world.arrange(world.new_arrangement(rng))
-            print(f"\nExecution in a new arrangement under {world.lighting_name} lighting:")
-            outcomes = execute_recipe(grounding, recipe, world, manipulator, rng, args.tau, narrate=narrate)
-        finally:
-            manipulator.close()
+        lighting = args.lighting or next(iter(world.setup.lighting))
+        print(f"\nExecution in a new arrangement under {lighting} lighting:")
+        outcomes = execute_in_new_arrangement(grounding, recipe, world, rng, args.grasp, lighting, args.tau, narrate)
         _print_outcomes(outcomes)
+        hint = lighting_hint(demonstrations, world.lighting_name, outcomes)
+        if hint:
+            print(hint)
+            summary["hint"] = hint
         summary["steps"] = [_outcome_summary(outcome) for outcome in outcomes]
         summary["success"] = all(outcome.success for outcome in outcomes)
         if narrate is not None:

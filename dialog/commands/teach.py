@@ -9,13 +9,13 @@ from pathlib import Path
 
 from dialog.commands._arguments import add_episode_options, budget, positive_seconds
 from dialog.commands._resume import check_resume_options
-from dialog.commands._viewer import add_viewer_option, start_viewer, stop_viewer
+from dialog.commands._viewer import add_viewer_option, hold_viewer, start_viewer, stop_viewer
 from dialog.environment import SimulatedKitchen
 from dialog.output_paths import check_writable
-from dialog.session import SessionSettings, open_session
+from dialog.session import TEACHERS, SessionSettings, open_session
 from dialog.transcript import read_session
 from dialog.transcript_lock import TranscriptLock
-from learning.errors import OutputPathError
+from learning.errors import OutputPathError, SettingsError, TranscriptError
 from learning.strategies import STRATEGY_NAMES
 
 PREFERRED_STRATEGIES = ("dt-task", "dt", "all-cd", "active")
@@ -45,7 +45,7 @@ def register(commands) -> None:
                              "if taken)")
     parser.add_argument("--resume", type=Path, default=None, metavar="FILE",
                         help="continue the session recorded in FILE with its own settings")
-    parser.add_argument("--teacher", choices=("terminal", "scripted", "replay"), default="terminal",
+    parser.add_argument("--teacher", choices=TEACHERS, default=SessionSettings().teacher["kind"],
                         help="who answers: you (terminal, default), a scripted oracle, or a recorded transcript")
     parser.add_argument("--replay", type=Path, default=None, metavar="FILE",
                         help="the transcript a replay teacher answers from")
@@ -82,7 +82,7 @@ def _settings(args) -> SessionSettings:
                        feature_quality=args.feature_quality, answer_delay=args.answer_delay)
     if args.teacher == "replay":
         if args.replay is None:
-            raise ValueError("--teacher replay needs --replay FILE (a transcript to answer from)")
+            raise SettingsError("--teacher replay needs --replay FILE (a transcript to answer from)")
         teacher["transcript"] = str(args.replay)
     return SessionSettings(task=args.task, kitchen=args.kitchen, strategy=args.strategy, seed=args.seed,
                            turns=args.turns, budget=args.budget, change_every=args.change_every,
@@ -93,7 +93,7 @@ def _claim_transcript(args) -> tuple[SessionSettings, Path, TranscriptLock]:
     """The session's settings, its transcript and the transcript's lock, taken before anything is checked."""
     if args.resume is not None:
         if not args.resume.exists():
-            raise FileNotFoundError(f"no transcript at {args.resume} to resume")
+            raise TranscriptError(f"no transcript at {args.resume} to resume")
         lock = TranscriptLock(args.resume, create=False)
         try:
             header = read_session(args.resume, tolerate_partial_tail=True)[0]
@@ -108,8 +108,8 @@ def _claim_transcript(args) -> tuple[SessionSettings, Path, TranscriptLock]:
     lock = TranscriptLock(path)
     if lock.size() > 0:
         lock.release()
-        raise ValueError(f"{path} already holds a session; continue it with --resume {path} or choose another "
-                         "--transcript")
+        raise TranscriptError(f"{path} already holds a session; continue it with --resume {path} or choose another "
+                              "--transcript")
     return settings, path, lock
 
 
@@ -170,23 +170,24 @@ def _teach(args, settings: SessionSettings, path: Path, lock: TranscriptLock, in
                                   f"teachbot teach --resume {path}") from None
         finally:
             manager.transcript.close()
+        if manager.replay_mismatches:
+            manager.say(f"(note: on {manager.replay_mismatches} replayed turn(s) the strategy would now ask something "
+                        "else; the recorded questions were kept)")
+        if result.quit:
+            manager.say(f"Session saved after {result.completed} of {result.turns} turns. Continue it with: "
+                        f"teachbot teach --resume {path}")
+        manager.say(f"Accuracy on {settings.task} held-out scenes: {result.accuracy:.1%} (chance "
+                    f"{1 / len(environment.concepts):.0%}); budget spent {result.budget_spent:g} of "
+                    f"{settings.budget:g}; queries {result.queries}; {result.seconds:.1f} s.")
+        if args.json:
+            print(json.dumps({"seed": result.seed, "strategy": result.strategy, "turns": result.turns,
+                              "completed": result.completed, "quit": result.quit, "budget_spent": result.budget_spent,
+                              "queries": result.queries, "accuracy": round(result.accuracy, 6),
+                              "transcript": str(path), "seconds": round(result.seconds, 3)}), file=out, flush=True)
+        hold_viewer(args, viewer, input_stream)
     finally:
         stop_viewer(viewer)
         environment.close()
-    if manager.replay_mismatches:
-        manager.say(f"(note: on {manager.replay_mismatches} replayed turn(s) the strategy would now ask something "
-                    "else; the recorded questions were kept)")
-    if result.quit:
-        manager.say(f"Session saved after {result.completed} of {result.turns} turns. Continue it with: "
-                    f"teachbot teach --resume {path}")
-    manager.say(f"Accuracy on {settings.task} held-out scenes: {result.accuracy:.1%} (chance "
-                f"{1 / len(environment.concepts):.0%}); budget spent {result.budget_spent:g} of {settings.budget:g}; "
-                f"queries {result.queries}; {result.seconds:.1f} s.")
-    if args.json:
-        print(json.dumps({"seed": result.seed, "strategy": result.strategy, "turns": result.turns,
-                          "completed": result.completed, "quit": result.quit, "budget_spent": result.budget_spent,
-                          "queries": result.queries, "accuracy": round(result.accuracy, 6),
-                          "transcript": str(path), "seconds": round(result.seconds, 3)}), file=out, flush=True)
     return 0
 
 

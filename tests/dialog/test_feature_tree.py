@@ -74,3 +74,88 @@ def test_feature_answers_are_never_guessed(tree, text, fragment):
 
 def test_a_symbol_line_is_no_command(tree):
     assert tree.read("%s").kind == "unreadable" and tree.read("s").kind == "skip"
+
+
+# -- a tree longer than a screen: groups first, "more N" opens one ------------------------------------------
+def real_tree():
+    from bullet_world.features import feature_catalogue
+
+    return FeatureTree([info.name for info in feature_catalogue()])
+
+
+def test_a_small_tree_is_shown_whole_and_a_group_name_chooses(tree):
+    assert not tree.collapsed and tree.overview() == tree.lines()
+    assert (tree.read("appearance").kind, tree.read("appearance").value) == ("answer", (0, 1, 2))
+    opened = tree.read("more 1.2")
+    assert opened.kind == "more" and opened.value == ("1.2",)
+    assert opened.message.splitlines() == ["1.2 geometry, 2 features (say '1.2' to use all of them):", "  1.2.1 size",
+                                           "    1.2.1.1 size.length: Length", "    1.2.1.2 size.height: Height"]
+
+
+def test_the_real_tree_shows_its_groups_in_twenty_lines_with_counts():
+    big = real_tree()
+    assert big.collapsed and len(big.lines()) > 100
+    lines = big.overview()
+    assert len(lines) <= 20 and all(len(line) <= 120 for line in lines)
+    groups = [node for node in big.nodes() if node.feature is None and node.number.count(".") <= 1]
+    for node in groups:
+        count = len(node.leaves())
+        assert any(line.strip().startswith(f"{node.number} {node.name}: {count} feature") for line in lines)
+    assert "more" in lines[-1]
+
+
+@pytest.mark.parametrize("text, number", [("more 3", "3"), ("More 1.1", "1.1"), ("open group 2", "2"),
+                                          ("appearance", "1.1"), ("more light", "2.2"), ("expand the 3.3", "3.3")])
+def test_more_or_a_bare_group_name_opens_a_group_of_the_real_tree(text, number):
+    big = real_tree()
+    reading = big.read(text)
+    assert reading.kind == "more" and reading.value == (number,)
+    node = big.by_number[number]
+    assert reading.message.splitlines()[0].startswith(f"{number} {node.name}, {len(node.leaves())} feature")
+    assert len(reading.message.splitlines()) <= 40
+
+
+def test_a_group_too_long_for_a_screen_opens_as_its_subgroups():
+    big = real_tree()
+    lines = big.read("more 1").message.splitlines()
+    assert len(lines) <= 10 and any(line.startswith("  1.4 location: 25 features") for line in lines)
+    assert lines[-1] == "(say 'more 1.1' to list one of them)"
+
+
+def test_opening_costs_no_answer_and_choosing_still_works_on_the_real_tree():
+    big = real_tree()
+    appearance = tuple(big.by_number["1.1"].leaves())
+    assert big.read("use appearance").value == appearance and big.read("1.1").value == appearance
+    assert big.read("weight").kind == "answer"  # a feature's name chooses it
+    assert set(big.read("ignore light").value) == set(range(len(big.feature_names))) - set(big.read("2.2").value)
+    for text, fragment in (("more 9", "'9'"), ("more", "I can't open:"), ("more colour, size", "'colour, size'")):
+        reading = big.read(text)
+        assert reading.kind == "unreadable" and fragment in reading.message and "'ignore'" in reading.message
+
+
+def test_the_question_stays_open_after_more_and_the_list_is_not_reprinted_after_undo():
+    import io
+
+    import numpy as np
+
+    from dialog.clock import VirtualClock
+    from dialog.conversation import converse
+    from dialog.parsing import AnswerParser
+    from dialog.questions import Prompt
+    from dialog.terminal import TerminalTeacher
+    from learning.actions import FeatureQuery
+    from tests.dialog.fakes import CONCEPTS, FakeEnvironment
+
+    big = real_tree()
+    scene = FakeEnvironment().next_scene(np.random.default_rng(0))
+    question = Prompt(1, 10, 5.0, FeatureQuery(), "Which features tell fruit and snack apart?", "", scene, CONCEPTS,
+                      details=big.overview(), feature_tree=big)
+    out = io.StringIO()
+    teacher = TerminalTeacher(io.StringIO("more 1.1\nundo\n1.1, 1.2\n"), out, clock=VirtualClock())
+    first = converse(teacher, question, AnswerParser(CONCEPTS), VirtualClock())
+    assert (first.kind, first.lines) == ("undo", ["more 1.1", "undo"])
+    second = converse(teacher, question, AnswerParser(CONCEPTS), VirtualClock())
+    assert second.kind == "answer" and len(second.value) == 24
+    text = out.getvalue()
+    assert text.count("1 object: 51 features") == 1 and text.count("1.1.1.1 colour.red") == 1
+    assert len(text.splitlines()) < 50
