@@ -1,6 +1,6 @@
 # Two commands on a fresh machine:
 #   make demo   set up .venv (torch CPU wheel first) and run a teaching episode
-#   make test   set up .venv and run the test suite and the linter
+#   make test   set up .venv, then run the linter (ruff), the type checker (mypy, on learning/) and the tests
 PYTHON ?= python3
 VENV ?= .venv
 PY := $(VENV)/bin/python
@@ -19,9 +19,10 @@ demo: $(STAMP)
 
 test: $(STAMP)
 	$(VENV)/bin/ruff check .
+	$(VENV)/bin/mypy
 	$(PY) -m pytest; status=$$?; \
 	if [ $$status -eq 5 ]; then echo "pytest collected no tests: that is a failure here"; exit 1; fi; \
 	exit $$status
 
 clean:
-	rm -rf $(VENV) runs .pytest_cache .ruff_cache
+	rm -rf $(VENV) runs .pytest_cache .ruff_cache .mypy_cache

@@ -137,7 +137,7 @@ class ConceptClassifier(ClassifierMixin, BaseEstimator):
 
 def _positive(value) -> bool:
     return isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, bool) \
-        and np.isfinite(value) and value > 0
+        and bool(np.isfinite(value)) and bool(value > 0)
 
 
 def _is_text(labels: np.ndarray) -> bool:

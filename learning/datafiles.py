@@ -12,14 +12,15 @@ from __future__ import annotations
 
 import difflib
 import math
+import sys
 from collections.abc import Iterable
 from pathlib import Path
 
 from learning.errors import DataFileError
 
-try:
+if sys.version_info >= (3, 11):
     import tomllib
-except ModuleNotFoundError:  # Python 3.10
+else:  # Python 3.10
     import tomli as tomllib
 
 __all__ = ["REQUIRED", "DataFileError", "MissingDataFileError", "check_keys", "flag", "integer", "number",
@@ -122,7 +123,7 @@ def number(table: dict, key: str, where: str, default=REQUIRED, low=None, high=N
 def integer(table: dict, key: str, where: str, default=REQUIRED, low=None, high=None) -> int:
     """A whole number within ``low``..``high`` (inclusive)."""
     present, value = _present(table, key, where, default)
-    return _check_number(value, f"'{key}'", where, True, low, high, None, None) if present else value
+    return int(_check_number(value, f"'{key}'", where, True, low, high, None, None)) if present else value
 
 
 def text(table: dict, key: str, where: str, default=REQUIRED, choices: Iterable[str] | None = None,

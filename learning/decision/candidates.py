@@ -104,14 +104,15 @@ def expected_decision_features(state, engine: str | WhatIfEngine = "fast", windo
     learned = expected[:, : demo_phi.shape[-1]]
     positions = {kind: [i for i, a in enumerate(actions) if a.kind == kind] for kind in ("demo", "label", "feature")}
     if positions["demo"]:  # the teacher's object x with p(x|y), the classifier's column normalised over the scene
-        ys = [concept_index[actions[i].concept] for i in positions["demo"]]
+        ys = [concept_index[a.concept] for a in actions if isinstance(a, DemoQuery)]
         weights = np.array([_normalised(P[:, y]) for y in ys])
         learned[positions["demo"]] = np.einsum("dx,dxk->dk", weights, demo_phi[ys])
     if positions["label"]:  # the teacher's concept y with p(y|x) normalised over the concepts
-        objects = [actions[i].object_index for i in positions["label"]]
+        objects = [a.object_index for a in actions if isinstance(a, LabelQuery)]
         rows = [label_rows[x] for x in objects]
         learned[positions["label"]] = np.einsum("ly,lyk->lk", label_distribution(P)[objects], label_phi[rows])
     if positions["feature"]:  # each F_{y,c} with probability 1/|Y|
+        assert feature_phi is not None, "the engine simulates the feature query whenever one is a candidate"
         learned[positions["feature"]] = feature_phi.mean(axis=0)
     after = {}  # the next turn's environment features, per query cost
     for i, action in enumerate(actions):

@@ -157,4 +157,4 @@ def weights_from_mapping(data: Mapping, feature_names: Sequence[str] | None = No
     except ValueError as error:
         message = str(error)
         raise DataFileError(message if message.startswith(source) else f"{source}: {message}") from None
-    return DecisionWeights(names, [float(table[name]) for name in names], provenance)
+    return DecisionWeights(names, np.array([float(table[name]) for name in names]), provenance)

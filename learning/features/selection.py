@@ -150,7 +150,8 @@ def _representatives(feature_su: np.ndarray) -> np.ndarray:
     Doubling every feature of a subset leaves its merit unchanged, a plateau
     greedy elimination cannot cross, so the search sees one member per copy group.
     """
-    return ~np.triu(feature_su >= 1.0 - COPY_TOLERANCE, k=1).any(axis=0)
+    copies_earlier = np.triu(feature_su >= 1.0 - COPY_TOLERANCE, k=1)
+    return ~np.asarray(copies_earlier.any(axis=0))
 
 
 def _forward(class_su: np.ndarray, feature_su, max_features: int | None) -> np.ndarray:

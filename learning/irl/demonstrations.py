@@ -26,11 +26,12 @@ from pathlib import Path
 
 import numpy as np
 
-from learning.actions import DEFAULT_COSTS
+from learning.actions import ACTION_KINDS
+from learning.datafiles import MissingDataFileError
+from learning.errors import DataFileError
 
 FORMAT_NAME = "teachbot-irl-demonstrations"
 FORMAT_VERSION = 1
-ACTION_KINDS: tuple[str, ...] = tuple(DEFAULT_COSTS)  # label, demo, feature, none
 NO_QUERY_KIND = "none"
 FEATURE_NAME_PATTERN = re.compile(r"^[A-Za-z][A-Za-z0-9_-]*$")
 ACCEPTED_SUFFIXES = (".json", ".npz")
@@ -52,8 +53,10 @@ def check_feature_names(names: Sequence[str], source: str = "feature names") -> 
 
 
 def _optional_strings(values, n_actions: int, what: str) -> tuple[str, ...] | None:
-    if values is None:
-        return None
+    return None if values is None else _strings(values, n_actions, what)
+
+
+def _strings(values, n_actions: int, what: str) -> tuple[str, ...]:
     if isinstance(values, str) or not isinstance(values, Sequence | np.ndarray):
         raise ValueError(f"action {what} must be a list of {n_actions} strings, got {type(values).__name__}")
     values = tuple(values)
@@ -134,10 +137,10 @@ def turn_with_no_query(state_phi, query_phi, chosen: int | None, query_kinds=Non
         raise ValueError(f"chosen query must be None (no query) or an index in 0..{n_queries - 1}, got {chosen!r}")
     kinds = None
     if query_kinds is not None:
-        kinds = (*_optional_strings(query_kinds, n_queries, "kinds"), NO_QUERY_KIND)
+        kinds = (*_strings(query_kinds, n_queries, "kinds"), NO_QUERY_KIND)
     labels = None
     if query_labels is not None:
-        labels = (*_optional_strings(query_labels, n_queries, "labels"), "no query")
+        labels = (*_strings(query_labels, n_queries, "labels"), "no query")
     return DecisionTurn(np.vstack([query_phi, state_phi[None, :]]), n_queries if chosen is None else int(chosen),
                         kinds, labels)
 
@@ -207,7 +210,7 @@ def save_episodes(path: str | Path, episodes: Sequence[QuestioningEpisode]) -> P
                     "episodes": [_episode_to_json(e) for e in episodes]}
         path.write_text(json.dumps(document, indent=1, allow_nan=False) + "\n", encoding="utf-8")
     elif path.suffix == ".npz":
-        np.savez_compressed(path, **_episodes_to_arrays(names, episodes))
+        np.savez_compressed(path, allow_pickle=False, **_episodes_to_arrays(names, episodes))
     else:
         raise ValueError(f"{path}: unknown demonstration file type {path.suffix!r}; accepted: .json, .npz")
     return path
@@ -217,7 +220,7 @@ def load_episodes(path: str | Path) -> list[QuestioningEpisode]:
     """Read a ``.json`` or ``.npz`` demonstration file; bad content raises a one-line ValueError naming the file."""
     path = Path(path)
     if not path.is_file():
-        raise FileNotFoundError(f"demonstration file {path} does not exist")
+        raise MissingDataFileError(f"demonstration file {path} does not exist")
     try:
         if path.suffix == ".json":
             return _episodes_from_json(path)
@@ -225,18 +228,18 @@ def load_episodes(path: str | Path) -> list[QuestioningEpisode]:
             return _episodes_from_npz(path)
     except ValueError as error:
         message = str(error)
-        raise ValueError(message if message.startswith(str(path)) else f"{path}: {message}") from None
-    raise ValueError(f"{path}: unknown demonstration file type {path.suffix!r}; accepted: .json, .npz")
+        raise DataFileError(message if message.startswith(str(path)) else f"{path}: {message}") from None
+    raise DataFileError(f"{path}: unknown demonstration file type {path.suffix!r}; accepted: .json, .npz")
 
 
 def load_episode_dir(directory: str | Path) -> list[QuestioningEpisode]:
     """Every ``*.json`` and ``*.npz`` demonstration file in a directory, in name order; names must agree."""
     directory = Path(directory)
     if not directory.is_dir():
-        raise FileNotFoundError(f"demonstration directory {directory} does not exist")
+        raise MissingDataFileError(f"demonstration directory {directory} does not exist")
     files = sorted(p for p in directory.iterdir() if p.suffix in ACCEPTED_SUFFIXES and p.is_file())
     if not files:
-        raise ValueError(f"{directory}: no demonstration files (*.json or *.npz) found")
+        raise DataFileError(f"{directory}: no demonstration files (*.json or *.npz) found")
     episodes = [episode for file in files for episode in load_episodes(file)]
     common_feature_names(episodes, f"demonstrations in {directory}")
     return episodes
@@ -297,7 +300,8 @@ def _episodes_from_json(path: Path) -> list[QuestioningEpisode]:
                                           record.get("labels")))
             except ValueError as error:
                 raise ValueError(f"episode {e}, turn {t}: {error}") from None
-        episodes.append(QuestioningEpisode(names, turns, raw.get("name", f"episode-{e}"), raw.get("metadata", {})))
+        episodes.append(QuestioningEpisode(names, tuple(turns), raw.get("name", f"episode-{e}"),
+                                           raw.get("metadata", {})))
     return episodes
 
 
@@ -355,8 +359,8 @@ def _episodes_from_npz(path: Path) -> list[QuestioningEpisode]:
     for t in range(n_turns):
         lo, hi = int(turn_offsets[t]), int(turn_offsets[t + 1])
         try:
-            turns.append(DecisionTurn(phi[lo:hi], chosen[t], *(extras[a][lo:hi] if a in extras else None
-                                                              for a in ("kinds", "labels"))))
+            kinds, labels = (tuple(extras[a][lo:hi]) if a in extras else None for a in ("kinds", "labels"))
+            turns.append(DecisionTurn(phi[lo:hi], chosen[t], kinds, labels))
         except ValueError as error:
             raise ValueError(f"turn {t}: {error}") from None
     episodes = []
@@ -365,6 +369,6 @@ def _episodes_from_npz(path: Path) -> list[QuestioningEpisode]:
             metadata = json.loads(str(arrays["episode_metadata"][e]))
         except json.JSONDecodeError:
             raise ValueError(f"episode {e}: metadata is not valid JSON") from None
-        episodes.append(QuestioningEpisode(names, turns[episode_offsets[e]:episode_offsets[e + 1]],
+        episodes.append(QuestioningEpisode(names, tuple(turns[episode_offsets[e]:episode_offsets[e + 1]]),
                                            str(arrays["episode_names"][e]), metadata))
     return episodes

@@ -13,13 +13,19 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
+from learning.datafiles import MissingDataFileError
 from learning.decision.features import FEATURE_NAMES
 from learning.decision.weights_file import DecisionWeights
+from learning.errors import DataFileError, SettingsError
 from learning.irl.demonstrations import QuestioningEpisode, load_episode_dir, load_episodes
 from learning.irl.policy import greedy_choice
+
+if TYPE_CHECKING:
+    from learning.irl.maxent import IrlResult  # torch: imported only when fitting
 
 SHIPPED = "shipped"
 SHIPPED_DEMOS = Path(__file__).resolve().parent / "expert-demos"
@@ -30,21 +36,21 @@ def load_demonstrations(spec: str | Path) -> list[QuestioningEpisode]:
     """Episodes from ``shipped``, a directory of .json/.npz files or one such file; clear errors otherwise."""
     path = SHIPPED_DEMOS if str(spec) == SHIPPED else Path(spec)
     if not path.exists():
-        raise FileNotFoundError(f"--demos {spec}: no such file or directory; give a directory of .json/.npz "
-                                "demonstration files, one such file, or the word 'shipped'")
+        raise MissingDataFileError(f"--demos {spec}: no such file or directory; give a directory of .json/.npz "
+                                   "demonstration files, one such file, or the word 'shipped'")
     episodes = load_episode_dir(path) if path.is_dir() else load_episodes(path)
     names = episodes[0].feature_names
     if tuple(names) != FEATURE_NAMES:
-        raise ValueError(f"--demos {spec}: the demonstrations record the features {list(names)}; DT-task-env weighs "
-                         f"{list(FEATURE_NAMES)} (in that order)")
+        raise DataFileError(f"--demos {spec}: the demonstrations record the features {list(names)}; DT-task-env weighs "
+                            f"{list(FEATURE_NAMES)} (in that order)")
     return episodes
 
 
 def default_validation_count(n_episodes: int) -> int:
     """All but three episodes validate (the thesis trained on three); at least one does."""
     if n_episodes < 2:
-        raise ValueError(f"learning weights needs at least 2 demonstration episodes (one to train, one to "
-                         f"validate), got {n_episodes}")
+        raise DataFileError(f"learning weights needs at least 2 demonstration episodes (one to train, one to "
+                            f"validate), got {n_episodes}")
     return max(1, n_episodes - THESIS_TRAINING_EPISODES)
 
 
@@ -68,7 +74,7 @@ def decision_agreement(episodes, weights: np.ndarray) -> dict[str, float]:
 @dataclass(frozen=True)
 class LearnedWeights:
     weights: DecisionWeights
-    result: object  # learning.irl.maxent.IrlResult
+    result: IrlResult
     train: list
     validation: list
     seconds: float  # loading, splitting and fitting
@@ -90,8 +96,12 @@ def learn_weights(demos: str | Path, iterations: int = 100, seed: int = 0,
 
     episodes = load_demonstrations(demos)
     n_validation = default_validation_count(len(episodes)) if n_validation is None else n_validation
+    if n_validation < 1:  # the kept iterate is the best on validation: there must be some
+        raise SettingsError(f"n_validation must be at least 1 (weights are kept by validation agreement), "
+                            f"got {n_validation}")
     train, validation = split_episodes(episodes, n_validation, np.random.default_rng(seed))
     result = fit_maxent_irl(train, validation, IrlConfig(max_iterations=iterations, seed=seed, policy=policy))
+    assert result.validation_agreement is not None, "n_validation >= 1 gives validation episodes"
     fitted = result.weights.provenance
     diagnostics = decision_agreement(validation, result.weights.values)
     provenance = {"method": "maxent-irl", "variant": fitted["method"], "policy": fitted["policy"],

@@ -171,11 +171,13 @@ class AdamAscent:
 
     def __init__(self, learning_rate: float, beta1: float = 0.9, beta2: float = 0.999, epsilon: float = 1e-8):
         self.learning_rate, self.beta1, self.beta2, self.epsilon = learning_rate, beta1, beta2, epsilon
-        self.steps, self.mean, self.square = 0, None, None
+        self.steps = 0
+        self.mean: np.ndarray | None = None
+        self.square: np.ndarray | None = None
 
     def step(self, x: np.ndarray, ascent: np.ndarray) -> np.ndarray:
         """The next iterate, moving x along the (bias-corrected, per-coordinate scaled) direction ``ascent``."""
-        if self.mean is None:
+        if self.mean is None or self.square is None:
             self.mean, self.square = np.zeros_like(x), np.zeros_like(x)
         self.steps += 1
         self.mean = self.beta1 * self.mean + (1 - self.beta1) * ascent
@@ -295,6 +297,7 @@ def _fit_per_turn(train, validation, config: IrlConfig, initial_weights) -> IrlR
         record = IterationRecord(len(history), loss, train_turns.agreement(w),
                                  validation_turns.agreement(w) if validation_turns is not None else None)
         history.append(record)
+        key: tuple[float | None, float | None]  # validation agreement is None only without held-out turns
         if held_out is not None:
             with torch.no_grad():
                 key = (record.validation_agreement, float(held_out.mean_log_likelihood(torch.from_numpy(x))))
@@ -340,6 +343,7 @@ def make_result(names: tuple[str, ...], w: np.ndarray, identifiable: np.ndarray,
     provenance = {**settings, "iterations": iterations, "best_iteration": best_iteration,
                   "train_turns": len(train_turns), "train_agreement": round(kept.train_agreement, 6)}
     if validation_turns is not None:
+        assert kept.validation_agreement is not None, "every record has it when there are validation turns"
         provenance.update(validation_turns=len(validation_turns),
                           validation_agreement=round(kept.validation_agreement, 6))
     return IrlResult(

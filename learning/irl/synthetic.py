@@ -26,7 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from learning.actions import DEFAULT_COSTS
+from learning.actions import DEFAULT_COSTS, ActionKind
 from learning.irl.demonstrations import DecisionTurn, QuestioningEpisode, turn_with_no_query
 from learning.irl.policy import greedy_choice, sample_choice
 
@@ -55,8 +55,9 @@ class SyntheticQuestioningTask:
     def episode(self, policy: Policy, rng: np.random.Generator, name: str = "") -> QuestioningEpisode:
         """Play one episode, ``policy(turn, rng)`` choosing each turn's action index."""
         learning = rng.uniform(0.1, 0.3, 4)
-        spent, history, feature_query_asked = 0.0, [], False
-        turns = []
+        spent, feature_query_asked = 0.0, False
+        history: list[str] = []
+        turns: list[DecisionTurn] = []
         for t in range(self.turns):
             if t % self.change_every == 0:
                 learning = np.clip(learning - rng.uniform(0.05, 0.15, 4), 0.0, 1.0) if t else learning
@@ -66,8 +67,11 @@ class SyntheticQuestioningTask:
             state[BUDGET] = spent / self.budget
             state[TIME] = (self.turns - t) / self.turns
             state[NON_QUERY] = self._non_query_time(history)
-            kinds = ["label"] * n_objects + ["demo"] * self.concepts + ([] if feature_query_asked else ["feature"])
-            kinds = [kind for kind in kinds if spent + DEFAULT_COSTS[kind] <= self.budget]
+            offered: list[ActionKind] = ["label"] * n_objects
+            offered += ["demo"] * self.concepts
+            if not feature_query_asked:
+                offered.append("feature")
+            kinds = [kind for kind in offered if spent + DEFAULT_COSTS[kind] <= self.budget]
             rows = np.tile(state, (len(kinds), 1))
             for row, kind in zip(rows, kinds):
                 mean, spread = EXPECTED_GAIN[kind]
@@ -78,7 +82,7 @@ class SyntheticQuestioningTask:
             choice = policy(turn, rng)
             turn = DecisionTurn(turn.phi, choice, turn.kinds)
             turns.append(turn)
-            kind = turn.kinds[choice]
+            kind = kinds[choice] if choice < len(kinds) else "none"  # no query is the last candidate
             if kind != "none":
                 learning = np.clip(turn.phi[choice, LEARNING] + rng.normal(0, self.outcome_noise, 4), 0.0, 1.0)
                 spent += DEFAULT_COSTS[kind]
@@ -86,7 +90,7 @@ class SyntheticQuestioningTask:
             history.append("none" if kind == "none" else "query")
         metadata = {"source": "synthetic", "budget": self.budget, "turns": self.turns,
                     "change_every": self.change_every}
-        return QuestioningEpisode(DT_TASK_ENV_FEATURES, turns, name, metadata)
+        return QuestioningEpisode(DT_TASK_ENV_FEATURES, tuple(turns), name, metadata)
 
     def _non_query_time(self, history: list[str]) -> float:
         window = history[-self.change_every:]

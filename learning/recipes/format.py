@@ -126,7 +126,7 @@ def load_builtin_recipe(name: str) -> Recipe:
     """Load a shipped recipe by name, e.g. ``"serve-pasta"``."""
     names = builtin_recipe_names()
     if name not in names:
-        raise ValueError(f"unknown built-in recipe {name!r}; accepted: {', '.join(names)}")
+        raise DataFileError(f"unknown built-in recipe {name!r}; accepted: {', '.join(names)}")
     return load_recipe(BUILTIN_RECIPE_DIR / f"{name}.toml")
 
 
@@ -161,13 +161,15 @@ def _first_problem_in_recipe(name: object, steps: tuple[object, ...]) -> str | N
         return "the name must be a non-empty string"
     if not steps:
         return "a recipe needs at least one step"
+    checked: list[RecipeStep] = []
     for number, step in enumerate(steps, start=1):
         if not isinstance(step, RecipeStep):
             return f"step {number} must be a RecipeStep, got {type(step).__name__}"
         if step.action not in ACCEPTED_ACTIONS:
             return f"step {number}: unknown action {step.action!r}; accepted actions: {', '.join(ACCEPTED_ACTIONS)}"
-    objects = {step.object for step in steps}
-    locations = {step.start for step in steps} | {step.end for step in steps}
+        checked.append(step)
+    objects = {step.object for step in checked}
+    locations = {step.start for step in checked} | {step.end for step in checked}
     both = sorted(objects & locations)
     if both:
         return (

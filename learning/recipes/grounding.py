@@ -37,6 +37,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from learning.errors import SettingsError
 from learning.recipes.format import Recipe, RecipeStep, recipe_parameters
 from learning.recipes.parameter_models import ParameterModel
 
@@ -237,7 +238,7 @@ class RecipeGrounding:
     ) -> ObjectChoice:
         """Pick the object for ``step`` in a new scene (thesis §4.2.4, eq. 4.3)."""
         if not np.isfinite(tau) or tau <= 0:
-            raise ValueError(f"tau must be a positive number, got {tau!r}")
+            raise SettingsError(f"tau must be a positive number, got {tau!r}")
         features, locations = _checked_scene(scene_features, scene_locations, "scene")
         start_model = self._model_for(self.location_models, step.start, "location")
         object_model = self._model_for(self.object_models, step.object, "object")
@@ -326,6 +327,7 @@ class RecipeGrounding:
         noise_std: Sequence[float] | float,
     ) -> None:
         if name not in models:
+            assert self.rng is not None, "__post_init__ replaces rng=None with a Generator"
             models[name] = ParameterModel(noise_std, self.max_components, rng=self.rng.spawn(1)[0])
         models[name].fit(np.vstack(samples[name]), n_demonstrations=demos[name])
 

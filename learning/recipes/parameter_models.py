@@ -33,6 +33,8 @@ tau = 3.0. ``log_likelihood`` is the log density of the whole mixture (eq. 4.3).
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 from scipy.linalg import solve_triangular
 from scipy.special import logsumexp
@@ -51,7 +53,7 @@ class ParameterModel:
 
     def __init__(
         self,
-        noise_std: float | np.ndarray,
+        noise_std: float | Sequence[float] | np.ndarray,
         max_components: int | None = None,
         rng: np.random.Generator | None = None,
         *,
@@ -113,13 +115,13 @@ class ParameterModel:
     @property
     def n_components_(self) -> int:
         """k of the hypothesis chosen by BIC."""
-        self._require_fitted()
-        return int(self.means_.shape[0])
+        _, means, _ = self._fitted()
+        return int(means.shape[0])
 
     @property
     def dimension_(self) -> int:
-        self._require_fitted()
-        return int(self.means_.shape[1])
+        _, means, _ = self._fitted()
+        return int(means.shape[1])
 
     def candidate_component_counts(self) -> list[int]:
         """The k values tried: 1..min(m, distinct samples, max_components)."""
@@ -133,6 +135,7 @@ class ParameterModel:
 
     def _refit(self) -> None:
         data = self.samples_
+        assert data is not None, "_refit runs only after samples_ is set"
         noise = self._noise_for(data.shape[1])
         best: tuple[float, np.ndarray, np.ndarray, np.ndarray] | None = None
         self.bic_per_k_ = {}
@@ -145,22 +148,24 @@ class ParameterModel:
             self.bic_per_k_[k] = float(bic)
             if best is None or bic < best[0]:
                 best = (bic, weights, means, covariances)
+        assert best is not None, "candidate_component_counts() is never empty once samples_ is set"
         _, self.weights_, self.means_, self.covariances_ = best
 
     @staticmethod
-    def _fit_one_component(data: np.ndarray, noise: np.ndarray):
+    def _fit_one_component(data: np.ndarray, noise: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         mean = data.mean(axis=0)
         centred = data - mean
         covariance = centred.T @ centred / data.shape[0] + np.diag(noise**2)
         return np.ones(1), mean[None, :], covariance[None, :, :]
 
-    def _fit_mixture(self, data: np.ndarray, noise: np.ndarray, k: int):
+    def _fit_mixture(self, data: np.ndarray, noise: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Best of ``n_init`` EM runs (highest log-likelihood), floor added every M-step."""
         best: tuple[float, np.ndarray, np.ndarray, np.ndarray] | None = None
         for _ in range(self.n_init):
             weights, means, covariances, log_l = _floored_em(data, noise, k, self._rng)
             if best is None or log_l > best[0]:
                 best = (log_l, weights, means, covariances)
+        assert best is not None, "n_init >= 1 is checked in __init__"
         _, weights, means, covariances = best
         order = np.lexsort(means.T[::-1])  # report components in a stable order
         return weights[order], means[order], covariances[order]
@@ -169,18 +174,19 @@ class ParameterModel:
     def mahalanobis(self, points: np.ndarray) -> np.ndarray:
         """Distance of each point to the nearest component (compare with tau, §4.2.4)."""
         queries = self._checked_points(points)
-        squared, _ = _squared_mahalanobis_and_log_dets(queries, self.means_, self.covariances_)
+        _, means, covariances = self._fitted()
+        squared, _ = _squared_mahalanobis_and_log_dets(queries, means, covariances)
         return np.sqrt(squared.min(axis=1))
 
     def log_likelihood(self, points: np.ndarray) -> np.ndarray:
         """Log density of each point under the whole mixture (eq. 4.3)."""
         queries = self._checked_points(points)
-        return _mixture_log_density(queries, self.weights_, self.means_, self.covariances_)
+        return _mixture_log_density(queries, *self._fitted())
 
     def heaviest_component_mean(self) -> np.ndarray:
         """Mean of the component with the largest weight (ties: the first)."""
-        self._require_fitted()
-        return self.means_[int(np.argmax(self.weights_))].copy()
+        weights, means, _ = self._fitted()
+        return means[int(np.argmax(weights))].copy()
 
     # ------------------------------------------------------------------ helpers
     def _noise_for(self, dimension: int) -> np.ndarray:
@@ -203,7 +209,7 @@ class ParameterModel:
         return data.copy()
 
     def _checked_points(self, points: np.ndarray) -> np.ndarray:
-        self._require_fitted()
+        self._fitted()
         queries = np.atleast_2d(np.asarray(points, dtype=float))
         if queries.ndim != 2 or queries.shape[1] != self.dimension_:
             raise ValueError(
@@ -213,12 +219,14 @@ class ParameterModel:
             raise ValueError("points contain NaN or infinite values; accepted: finite numbers")
         return queries
 
-    def _require_fitted(self) -> None:
-        if self.means_ is None:
+    def _fitted(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The chosen mixture's (weights, means, covariances); a ValueError before any data."""
+        if self.weights_ is None or self.means_ is None or self.covariances_ is None:
             raise ValueError("this ParameterModel has no data yet; call fit(samples) or add(sample)")
+        return self.weights_, self.means_, self.covariances_
 
     def __repr__(self) -> str:
-        if not self.is_fitted:
+        if not self.is_fitted or self.samples_ is None:
             return "ParameterModel(unfitted)"
         return (
             f"ParameterModel(k={self.n_components_}, d={self.dimension_}, "

@@ -18,8 +18,10 @@ dt-task-env DT on all seven decision features (thesis ch. 7; IRL weights)
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from functools import partial
 
+from learning.errors import SettingsError
 from learning.strategies.active import ActiveStrategy
 from learning.strategies.all_cd import AllClassDistributionStrategy
 from learning.strategies.base import Strategy
@@ -28,7 +30,7 @@ from learning.strategies.hfs import HfsActiveStrategy, HfsPassiveStrategy
 from learning.strategies.passive import PassiveStrategy
 from learning.strategies.random_choice import RandomStrategy
 
-STRATEGIES = {
+STRATEGIES: dict[str, Callable[..., Strategy]] = {
     "passive": PassiveStrategy,
     "active": ActiveStrategy,
     "random": RandomStrategy,
@@ -51,13 +53,13 @@ def make_strategy(name: str, **options) -> Strategy:
     """
     key = str(name).strip().lower()
     if key not in STRATEGIES:
-        raise ValueError(f"unknown strategy '{name}'; choose one of: {', '.join(STRATEGY_NAMES)}")
+        raise SettingsError(f"unknown strategy '{name}'; choose one of: {', '.join(STRATEGY_NAMES)}")
     if key == "dt" and "weights" in options:
         return DecisionTheoreticStrategy(name="dt", **options)
     try:
         return STRATEGIES[key](**options)
     except TypeError as error:
-        raise ValueError(f"strategy '{key}' does not take the options {sorted(options)} ({error})") from None
+        raise SettingsError(f"strategy '{key}' does not take the options {sorted(options)} ({error})") from None
 
 
 __all__ = ["STRATEGIES", "STRATEGY_NAMES", "DecisionTheoreticStrategy", "Strategy", "make_strategy"]

@@ -3,6 +3,7 @@
 import json
 
 import numpy as np
+import pytest
 
 from dialog.cli import main
 from learning.decision.features import FEATURE_NAMES
@@ -51,3 +52,12 @@ def test_the_gated_fit_asks_when_the_expert_asks_where_the_plain_softmax_stays_q
     softmax = learn_weights("shipped", policy="softmax").weights.provenance
     assert gated["validation_ask_or_quiet_agreement"] >= 0.8
     assert gated["validation_ask_or_quiet_agreement"] > softmax["validation_ask_or_quiet_agreement"] + 0.2
+
+
+def test_learning_weights_without_validation_episodes_is_refused_before_fitting():
+    """The kept iterate is the best on validation; with none held out the provenance had no agreement to round."""
+    from learning.errors import SettingsError
+    from learning.irl.learn import learn_weights
+
+    with pytest.raises(SettingsError, match=r"n_validation must be at least 1 \(.*\), got 0"):
+        learn_weights("shipped", n_validation=0)
