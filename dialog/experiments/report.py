@@ -53,6 +53,21 @@ def findings_summary_line(findings: list[FindingResult]) -> str:
     return "Summary: " + "; ".join(f"{o.finding.id} {o.verdict}" for o in findings) + "."
 
 
+def findings_closing_lines(findings: list[FindingResult], analysis: str) -> list[str]:
+    """After a findings table: the skipped findings, the summary, and the link to the written analysis."""
+    lines = ["", *skipped_findings_lines(findings), findings_summary_line(findings), ""]
+    if analysis:
+        lines += [f"Why each finding holds or not, and what differs from the thesis: {analysis}", ""]
+    return lines
+
+
+def write_markdown(lines: list[str], out: Path) -> Path:
+    """Write ``out/report.md`` from its lines."""
+    path = out / "report.md"
+    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    return path
+
+
 def markdown_report(suite: Suite, results: list[dict], summaries: list[CheckpointSummary],
                     findings: list[FindingResult], seconds: float, out: Path, figures: list[Path]) -> Path:
     """``report.md``: per condition the figures, accuracy at the checkpoints inside its turns, pairwise
@@ -107,9 +122,5 @@ def markdown_report(suite: Suite, results: list[dict], summaries: list[Checkpoin
                 lines.append(f"| {f.id}: {f.text} | {f.condition} | {f.at} {axis_name} | {c.a} > {c.b} | "
                              f"{c.mean_a:.3f} vs {c.mean_b:.3f} | {c.u:.1f} | {_fmt_p(c.p)} | "
                              f"{'yes' if c.significant else 'no'} |")
-        lines += ["", *skipped_findings_lines(findings), findings_summary_line(findings), ""]
-        if suite.analysis:
-            lines += [f"Why each finding holds or not, and what differs from the thesis: {suite.analysis}", ""]
-    path = out / "report.md"
-    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
-    return path
+        lines += findings_closing_lines(findings, suite.analysis)
+    return write_markdown(lines, out)

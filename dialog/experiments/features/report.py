@@ -11,7 +11,7 @@ import numpy as np
 from dialog.experiments.analysis import CheckpointSummary, FindingResult, pairwise
 from dialog.experiments.features.study import METHODS, UserModel, run_study
 from dialog.experiments.figures import pyplot
-from dialog.experiments.report import _fmt_p, findings_summary_line, skipped_findings_lines
+from dialog.experiments.report import _fmt_p, findings_closing_lines, write_markdown
 from dialog.experiments.suite import Suite
 from learning.errors import SettingsError
 from learning.significance import mean_and_standard_error
@@ -97,9 +97,5 @@ def write_feature_report(suite: Suite, rows: list[dict], summaries: list[Checkpo
             for c in outcome.comparisons:
                 lines.append(f"| {outcome.finding.id}: {outcome.finding.text} | {c.a} > {c.b} | {c.mean_a:.3f} vs "
                              f"{c.mean_b:.3f} | {c.u:.1f} | {_fmt_p(c.p)} | {'yes' if c.significant else 'no'} |")
-        lines += ["", *skipped_findings_lines(findings), findings_summary_line(findings), ""]
-        if suite.analysis:
-            lines += [f"Why each finding holds or not, and what differs from the thesis: {suite.analysis}", ""]
-    path = out / "report.md"
-    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
-    return path
+        lines += findings_closing_lines(findings, suite.analysis)
+    return write_markdown(lines, out)
