@@ -81,18 +81,7 @@ class FeatureTree:
 
     def lines(self) -> list[str]:
         """The tree as indented, numbered lines (groups, then each feature with its description)."""
-        out: list[str] = []
-
-        def walk(nodes, depth):
-            for node in nodes:
-                text = f"{'  ' * depth}{node.number} {node.name}"
-                if node.feature is not None and node.description:
-                    text += f": {node.description}"
-                out.append(text)
-                walk(node.children, depth + 1)
-
-        walk(self.roots, 0)
-        return out
+        return _tree_lines(self.roots, 0)
 
     def nodes(self):
         return self.by_number.values()
@@ -148,16 +137,7 @@ class FeatureTree:
         count = len(node.leaves())
         lines = [f"{node.number} {node.name}, {count} feature{'s' * (count != 1)} (say '{node.number}' to use "
                  f"all of them):"]
-
-        def walk(nodes, depth):
-            for child in nodes:
-                text = f"{'  ' * depth}{child.number} {child.name}"
-                if child.feature is not None and child.description:
-                    text += f": {child.description}"
-                lines.append(text)
-                walk(child.children, depth + 1)
-
-        walk(node.children, 1)
+        lines += _tree_lines(node.children, 1)
         if len(lines) <= 2 * OVERVIEW_LINES or not any(child.feature is None for child in node.children):
             return lines
         lines = lines[:1]  # too long for a screen: its subgroups, each to be opened in turn
@@ -313,3 +293,15 @@ def _sample(names, limit: int = 60) -> str:
         out.append(name)
         used += len(name) + 2
     return ", ".join(out)
+
+
+def _tree_lines(nodes, depth: int) -> list[str]:
+    """One indented line per node and its descendants: number, name, and a feature's description."""
+    lines: list[str] = []
+    for node in nodes:
+        text = f"{'  ' * depth}{node.number} {node.name}"
+        if node.feature is not None and node.description:
+            text += f": {node.description}"
+        lines.append(text)
+        lines += _tree_lines(node.children, depth + 1)
+    return lines
