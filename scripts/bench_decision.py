@@ -1,8 +1,8 @@
 """Interaction-time benchmark of the decision-theoretic choice: fast what-if engine vs the brute-force reference.
 
 Both engines score every candidate action (|Y| demos, |X| labels, the feature
-query when it is still open, no query) of the same seeded learning states and
-the DT rule picks one (thesis eq. 6.3, 7.1). States come from
+query when it is still open, no query), each at its own next state (eq. 7.1),
+of the same seeded learning states and the DT rule picks one. States come from
 ``learning.synthetic.random_state``: |Y| = 4 concepts, |F| = 90 features of
 which 6 are informative, a scene of |X| objects, n_train labelled examples
 with uneven classes, some budget spent and a random recent history; in about

@@ -8,9 +8,12 @@ utility U(s) = w . phi(s) the expected utility is EU(a) = w . E[phi(s') | a].
   (the per-concept classifier's probabilities, normalised over the scene).
 * LabelQuery(x): the teacher names concept y with p(y|x) normalised over the concepts.
 * FeatureQuery: every classifier switches to F_{y,c} with probability 1/|Y| each.
-* Every query's next state has spent + cost, one more turn gone and t_NQ = 0.
-* NoQuery's row is phi(s) itself, so "argmax over all rows" is the thesis rule
-  "take a* only if EU(a*) > U(s)" (eq. 6.3); ties go to no query.
+* Every action, no query included, is scored at its own next state s_{t+1} (eq. 7.1): the clock
+  advances one turn whatever is done. A query's next state has spent + cost and t_NQ = 0; NoQuery's
+  has spent (+ its cost, 0 by default), t_NQ = min(q + 1, W) / W for a quiet run q now and window W,
+  and the learning features of the current classifiers (nothing is learned by staying quiet).
+  "argmax over all rows" is the thesis rule "take a* only if EU(a*) > EU(no query)"; ties go to no
+  query. ``current`` keeps phi(s) itself, which no longer equals any row.
 
 Candidates, in this fixed order: a DemoQuery per concept (state.concepts
 order; not for a concept the teacher could not show in this scene), a
@@ -43,7 +46,7 @@ class CandidateFeatures:
 
     actions: tuple[Action, ...]
     expected: np.ndarray  # (len(actions), len(FEATURE_NAMES))
-    current: np.ndarray  # phi(s), (len(FEATURE_NAMES),); equal to the NoQuery row
+    current: np.ndarray  # phi(s) now, (len(FEATURE_NAMES),); not the NoQuery row, which is at s_{t+1}
     feature_names: tuple[str, ...] = FEATURE_NAMES
 
     def utilities(self, weights) -> np.ndarray:
@@ -84,10 +87,12 @@ def expected_decision_features(state, engine: str | WhatIfEngine = "fast", windo
     counts = concept_counts(state)
     P = state.probabilities()
     current = features(P, counts, clock)
+    n_learning = len(current) - len(clock.features())
+    quiet = np.concatenate([current[:n_learning], clock.after(state.cost(NoQuery()), asked=False).features()])
     label_objects = [a.object_index for a in actions if a.kind == "label"]
     wants_feature_query = any(a.kind == "feature" for a in actions)
     if not (label_objects or wants_feature_query or any(a.kind == "demo" for a in actions)):
-        return CandidateFeatures(actions, np.tile(current, (len(actions), 1)), current)
+        return CandidateFeatures(actions, np.tile(quiet, (len(actions), 1)), current)
     outcomes = engine.simulate(state, label_objects, wants_feature_query)
     n_concepts = len(state.concepts)
     with_one_more = counts + np.eye(n_concepts)  # row y: the counts after one more example of concept y
@@ -117,7 +122,7 @@ def expected_decision_features(state, engine: str | WhatIfEngine = "fast", windo
     after = {}  # the next turn's environment features, per query cost
     for i, action in enumerate(actions):
         if action.kind == "none":
-            expected[i] = current
+            expected[i] = quiet
             continue
         cost = state.cost(action)
         if cost not in after:

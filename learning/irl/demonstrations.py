@@ -8,12 +8,17 @@ expects after taking it,
     Phi_t[a] = sum_{s'} P(s' | a, s_t) phi(s')          (thesis eq. 7.1, 7.2)
 
 so that EU(a | s_t) = w . Phi_t[a] for the linear utility U(s) = w . phi(s).
-The no-query action leaves the state unchanged: its row is phi(s_t). The
-expert's choice is the index of one row. Nothing here knows about the
+No query is scored at its next state too (eq. 7.1): the classifiers and the
+budget of s_t, the clock one turn on and one more quiet turn. The expert's
+choice is the index of one row. Nothing here knows about the
 simulator or the dialog: whoever records an episode fills these arrays.
 
 Files (no pickle): JSON (readable, for a few episodes) or NPZ (compact). Both
-hold a list of episodes that share one tuple of feature names.
+hold a list of episodes that share one tuple of feature names, and a
+``format_version``: 2 since the no-query row is at the next state. Files of
+version 1 (field ``version``, no query at phi(s_t)) are converted exactly on
+loading when they hold what that needs (``learning.irl.format_upgrade``), and
+refused otherwise, with a message saying how to record new ones.
 """
 
 from __future__ import annotations
@@ -29,9 +34,13 @@ import numpy as np
 from learning.actions import ACTION_KINDS
 from learning.datafiles import MissingDataFileError
 from learning.errors import DataFileError
+from learning.irl.format_upgrade import NotConvertible, upgrade_episodes
 
 FORMAT_NAME = "teachbot-irl-demonstrations"
-FORMAT_VERSION = 1
+FORMAT_VERSION = 2  # 2: no query scored at the next state (eq. 7.1); 1: at the current state
+LEGACY_VERSIONS = (1,)  # read and converted on loading
+VERSION_KEY, LEGACY_VERSION_KEY = "format_version", "version"  # version 1 named its field "version"
+MAKE_NEW = "record new ones with scripts/make_expert_demos.py or `teachbot expert`"
 NO_QUERY_KIND = "none"
 FEATURE_NAME_PATTERN = re.compile(r"^[A-Za-z][A-Za-z0-9_-]*$")
 ACCEPTED_SUFFIXES = (".json", ".npz")
@@ -117,19 +126,19 @@ class DecisionTurn:
         return self.phi @ np.asarray(weights, dtype=np.float64)
 
 
-def turn_with_no_query(state_phi, query_phi, chosen: int | None, query_kinds=None,
+def turn_with_no_query(quiet_phi, query_phi, chosen: int | None, query_kinds=None,
                        query_labels=None) -> DecisionTurn:
-    """A turn whose last candidate is no query, with phi(s) as its row; ``chosen=None`` means the expert kept quiet.
+    """A turn whose last candidate is no query with row ``quiet_phi``; ``chosen=None`` means the expert kept quiet.
 
-    With NQ's value U(s) among the candidates, argmax over all of them is the DT
-    rule "take a* only if EU(a*) > U(s)" (thesis §6, §7.3.1), ties going to NQ.
+    ``quiet_phi`` is phi(s_{t+1}) after a quiet turn (eq. 7.1). With it among the candidates, argmax over
+    all of them is the DT rule "take a* only if EU(a*) > EU(no query)" (thesis §7.3.1), ties going to NQ.
     """
-    state_phi = np.asarray(state_phi, dtype=np.float64)
+    quiet_phi = np.asarray(quiet_phi, dtype=np.float64)
     query_phi = np.asarray(query_phi, dtype=np.float64)
-    if state_phi.ndim != 1:
-        raise ValueError(f"state features phi(s) must be a vector, got shape {state_phi.shape}")
-    if query_phi.ndim != 2 or query_phi.shape[1] != state_phi.shape[0]:
-        raise ValueError(f"query features must be a (n_queries x {state_phi.shape[0]}) matrix, "
+    if quiet_phi.ndim != 1:
+        raise ValueError(f"no-query features must be a vector, got shape {quiet_phi.shape}")
+    if query_phi.ndim != 2 or query_phi.shape[1] != quiet_phi.shape[0]:
+        raise ValueError(f"query features must be a (n_queries x {quiet_phi.shape[0]}) matrix, "
                          f"got shape {query_phi.shape}")
     n_queries = query_phi.shape[0]
     if chosen is not None and (isinstance(chosen, bool) or not isinstance(chosen, int | np.integer)
@@ -141,7 +150,7 @@ def turn_with_no_query(state_phi, query_phi, chosen: int | None, query_kinds=Non
     labels = None
     if query_labels is not None:
         labels = (*_strings(query_labels, n_queries, "labels"), "no query")
-    return DecisionTurn(np.vstack([query_phi, state_phi[None, :]]), n_queries if chosen is None else int(chosen),
+    return DecisionTurn(np.vstack([query_phi, quiet_phi[None, :]]), n_queries if chosen is None else int(chosen),
                         kinds, labels)
 
 
@@ -206,7 +215,7 @@ def save_episodes(path: str | Path, episodes: Sequence[QuestioningEpisode]) -> P
     path = Path(path)
     names = common_feature_names(episodes)
     if path.suffix == ".json":
-        document = {"format": FORMAT_NAME, "version": FORMAT_VERSION, "feature_names": list(names),
+        document = {"format": FORMAT_NAME, VERSION_KEY: FORMAT_VERSION, "feature_names": list(names),
                     "episodes": [_episode_to_json(e) for e in episodes]}
         path.write_text(json.dumps(document, indent=1, allow_nan=False) + "\n", encoding="utf-8")
     elif path.suffix == ".npz":
@@ -257,11 +266,34 @@ def _episode_to_json(episode: QuestioningEpisode) -> dict:
     return {"name": episode.name, "metadata": episode.metadata, "turns": turns}
 
 
-def _check_header(format_name, version) -> None:
+def _check_header(format_name, version) -> int:
     if format_name != FORMAT_NAME:
         raise ValueError(f"not a demonstration file: 'format' is {format_name!r}, expected {FORMAT_NAME!r}")
-    if version != FORMAT_VERSION:
-        raise ValueError(f"demonstration format version {version!r} is not supported; accepted: {FORMAT_VERSION}")
+    if isinstance(version, bool) or version not in (FORMAT_VERSION, *LEGACY_VERSIONS):
+        raise ValueError(f"demonstration format version {version!r} is not supported; accepted: {FORMAT_VERSION} "
+                         f"(and {', '.join(map(str, LEGACY_VERSIONS))}, converted on loading); {MAKE_NEW}")
+    return int(version)
+
+
+def _version_field(fields) -> str | None:
+    """The name of the file's version field: format_version, or version 1's "version"; None if it has neither."""
+    present = [key for key in (VERSION_KEY, LEGACY_VERSION_KEY) if key in fields]
+    if len(present) > 1:
+        raise ValueError(f"both {VERSION_KEY!r} and {LEGACY_VERSION_KEY!r} are given; a file has one "
+                         f"({VERSION_KEY!r} since version {FORMAT_VERSION})")
+    return present[0] if present else None
+
+
+def _current(episodes: list[QuestioningEpisode], version: int) -> list[QuestioningEpisode]:
+    """Episodes in the current format: old versions converted exactly, or refused saying how to make new ones."""
+    if version == FORMAT_VERSION:
+        return episodes
+    try:
+        return upgrade_episodes(episodes)
+    except NotConvertible as error:
+        raise ValueError(f"demonstration format version {version} scores no query at the current state and "
+                         f"cannot be converted to version {FORMAT_VERSION} (eq. 7.1, the next state): {error}; "
+                         f"{MAKE_NEW}") from None
 
 
 def _episodes_from_json(path: Path) -> list[QuestioningEpisode]:
@@ -270,12 +302,14 @@ def _episodes_from_json(path: Path) -> list[QuestioningEpisode]:
     except (json.JSONDecodeError, UnicodeDecodeError) as error:
         raise ValueError(f"{path}: not valid JSON ({error})") from None
     if not isinstance(document, dict):
-        raise ValueError("expected a JSON object with 'format', 'version', 'feature_names' and 'episodes'")
-    missing = [key for key in ("format", "version", "feature_names", "episodes") if key not in document]
+        raise ValueError("expected a JSON object with 'format', 'format_version', 'feature_names' and 'episodes'")
+    version_key = _version_field(document)
+    missing = [key for key in ("format", version_key or VERSION_KEY, "feature_names", "episodes")
+               if key not in document]
     if missing:
-        raise ValueError(f"missing field {missing[0]!r}; a demonstration file needs format, version, "
+        raise ValueError(f"missing field {missing[0]!r}; a demonstration file needs format, format_version, "
                          "feature_names and episodes")
-    _check_header(document["format"], document["version"])
+    version = _check_header(document["format"], document[version_key])
     names = check_feature_names(document["feature_names"], "field 'feature_names'")
     raw_episodes = document["episodes"]
     if not isinstance(raw_episodes, list) or not raw_episodes:
@@ -302,13 +336,13 @@ def _episodes_from_json(path: Path) -> list[QuestioningEpisode]:
                 raise ValueError(f"episode {e}, turn {t}: {error}") from None
         episodes.append(QuestioningEpisode(names, tuple(turns), raw.get("name", f"episode-{e}"),
                                            raw.get("metadata", {})))
-    return episodes
+    return _current(episodes, version)
 
 
 def _episodes_to_arrays(names: tuple[str, ...], episodes: Sequence[QuestioningEpisode]) -> dict[str, np.ndarray]:
     turns = [turn for episode in episodes for turn in episode.turns]
     arrays = {
-        "format": np.array(FORMAT_NAME), "version": np.array(FORMAT_VERSION),
+        "format": np.array(FORMAT_NAME), VERSION_KEY: np.array(FORMAT_VERSION),
         "feature_names": np.array(names),
         "phi": np.vstack([turn.phi for turn in turns]),
         "turn_offsets": np.cumsum([0] + [turn.n_actions for turn in turns]),
@@ -327,17 +361,19 @@ def _episodes_to_arrays(names: tuple[str, ...], episodes: Sequence[QuestioningEp
 
 
 def _episodes_from_npz(path: Path) -> list[QuestioningEpisode]:
-    required = ("format", "version", "feature_names", "phi", "turn_offsets", "chosen", "episode_offsets",
-                "episode_names", "episode_metadata")
     try:
         with np.load(path, allow_pickle=False) as data:
             arrays = {key: data[key] for key in data.files}
     except (OSError, ValueError, EOFError) as error:
         raise ValueError(f"{path}: not a readable NPZ archive without pickled objects ({error})") from None
+    version_key = _version_field(arrays) or VERSION_KEY
+    required = ("format", version_key, "feature_names", "phi", "turn_offsets", "chosen", "episode_offsets",
+                "episode_names", "episode_metadata")
     missing = [key for key in required if key not in arrays]
     if missing:
         raise ValueError(f"missing array {missing[0]!r}; a demonstration NPZ needs {', '.join(required)}")
-    _check_header(str(arrays["format"]), int(arrays["version"]) if arrays["version"].dtype.kind in "iu" else None)
+    raw_version = arrays[version_key]
+    version = _check_header(str(arrays["format"]), int(raw_version) if raw_version.dtype.kind in "iu" else None)
     names = check_feature_names([str(n) for n in arrays["feature_names"].tolist()], "array 'feature_names'")
     phi, turn_offsets, chosen = arrays["phi"], arrays["turn_offsets"], arrays["chosen"]
     episode_offsets = arrays["episode_offsets"]
@@ -371,4 +407,4 @@ def _episodes_from_npz(path: Path) -> list[QuestioningEpisode]:
             raise ValueError(f"episode {e}: metadata is not valid JSON") from None
         episodes.append(QuestioningEpisode(names, tuple(turns[episode_offsets[e]:episode_offsets[e + 1]]),
                                            str(arrays["episode_names"][e]), metadata))
-    return episodes
+    return _current(episodes, version)

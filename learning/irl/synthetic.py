@@ -7,11 +7,13 @@ by a policy with known weights have the shape of real ones (thesis §7.3.1):
 
 - candidates each turn: a label query per scene object (cost 1), a demo query
   per concept (cost 2), the feature-subset query until asked (cost 2), no query
-  (cost 0, row phi(s)); only affordable queries are offered, so once the
-  budget is spent no query is the only candidate;
-- budget consumption (spent + cost) / B; remaining time (T - t) / T, equal on
-  every candidate of a turn (time passes whatever is asked); non-query time,
-  the fraction of no-query turns in a window of ``change_every`` turns;
+  (cost 0); only affordable queries are offered, so once the budget is spent
+  no query is the only candidate;
+- every candidate, no query included, is scored at its next state (eq. 7.1):
+  budget consumption (spent + cost) / B; remaining time (T - t - 1) / T, equal
+  on every candidate of a turn (time passes whatever is asked); non-query time,
+  the fraction of no-query turns in a window of ``change_every`` turns ending
+  with this one; no query keeps the learning features;
 - a scene change every ``change_every`` turns lowers the learning features
   (the models meet objects in a new state), as in the training condition.
 
@@ -62,23 +64,23 @@ class SyntheticQuestioningTask:
             if t % self.change_every == 0:
                 learning = np.clip(learning - rng.uniform(0.05, 0.15, 4), 0.0, 1.0) if t else learning
                 n_objects = int(rng.integers(self.objects[0], self.objects[1] + 1))
-            state = np.empty(len(DT_TASK_ENV_FEATURES))
-            state[LEARNING] = learning
-            state[BUDGET] = spent / self.budget
-            state[TIME] = (self.turns - t) / self.turns
-            state[NON_QUERY] = self._non_query_time(history)
+            quiet = np.empty(len(DT_TASK_ENV_FEATURES))  # the next state after a quiet turn
+            quiet[LEARNING] = learning
+            quiet[BUDGET] = spent / self.budget
+            quiet[TIME] = (self.turns - t - 1) / self.turns
+            quiet[NON_QUERY] = self._non_query_time(history + ["none"])
             offered: list[ActionKind] = ["label"] * n_objects
             offered += ["demo"] * self.concepts
             if not feature_query_asked:
                 offered.append("feature")
             kinds = [kind for kind in offered if spent + DEFAULT_COSTS[kind] <= self.budget]
-            rows = np.tile(state, (len(kinds), 1))
+            rows = np.tile(quiet, (len(kinds), 1))
             for row, kind in zip(rows, kinds):
                 mean, spread = EXPECTED_GAIN[kind]
                 row[LEARNING] = np.clip(learning + rng.normal(mean, spread, 4) * (1.0 - learning), 0.0, 1.0)
                 row[BUDGET] = (spent + DEFAULT_COSTS[kind]) / self.budget
                 row[NON_QUERY] = self._non_query_time(history + ["query"])
-            turn = turn_with_no_query(state, rows, None, kinds)
+            turn = turn_with_no_query(quiet, rows, None, kinds)
             choice = policy(turn, rng)
             turn = DecisionTurn(turn.phi, choice, turn.kinds)
             turns.append(turn)

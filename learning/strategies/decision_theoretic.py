@@ -2,9 +2,11 @@
 
 For every affordable candidate the what-if engine simulates every answer and
 ``learning.decision.candidates`` turns the simulated next states into E[phi(s') | a].
-With weights w the expected utility is EU(a) = w . E[phi(s') | a]; the learner
-takes the best query a* only if EU(a*) > U(s), else it asks nothing this turn.
-Ties between queries go to the first in candidate order (demos, labels, FSQ).
+With weights w the expected utility is EU(a) = w . E[phi(s') | a]; every action, no query
+included, is scored at its own next state (eq. 7.1: the clock moves on, staying quiet learns
+nothing and lengthens the quiet run). The learner takes the best query a* only if it beats
+EU(no query), else it asks nothing this turn; ties between queries go to the first in
+candidate order (demos, labels, FSQ). Every explanation says what no query was scored at.
 
 Named presets read their weights from learning/decision/presets/<name>.toml:
 ``dt`` (custom: edit the file or pass ``weights=``), ``dt-iros`` (ACD, CDU),
@@ -53,6 +55,13 @@ class DecisionTheoreticStrategy(Strategy):
         return Decision(action, _query_reason(state, action, utilities[best], utilities[stay]))
 
 
+def quiet_basis(state: LearningState) -> str:
+    """What EU(no query) is scored at (eq. 7.1), in words."""
+    run = state.quiet_run() + 1
+    return (f"both scored at the next turn; staying quiet learns nothing and makes {run} quiet "
+            f"turn{'s' if run != 1 else ''} in a row")
+
+
 def choose_index(utilities: np.ndarray) -> int:
     """argmax over the candidates, no query (the last) unless a query beats it by more than rounding."""
     queries, stay = utilities[:-1], utilities[-1]
@@ -71,7 +80,7 @@ def _describe(state: LearningState, action: Action) -> str:
 
 
 def _query_reason(state: LearningState, action: Action, utility: float, quiet: float) -> str:
-    numbers = f"expected utility {utility:.3f} against {quiet:.3f} if I stay quiet"
+    numbers = f"expected utility {utility:.3f} against {quiet:.3f} if I stay quiet, {quiet_basis(state)}"
     if action.kind == "label":
         P = normalise_rows(state.probabilities())
         first, second = (state.concepts[i] for i in np.argsort(P[action.object_index])[::-1][:2])
@@ -84,7 +93,8 @@ def _query_reason(state: LearningState, action: Action, utility: float, quiet: f
 
 
 def _quiet_reason(state: LearningState, best: Action, utility: float, quiet: float) -> str:
-    numbers = f"{_describe(state, best)} is worth {utility:.3f} against {quiet:.3f} for staying quiet"
+    numbers = (f"{_describe(state, best)} is worth {utility:.3f} against {quiet:.3f} for staying quiet, "
+               f"{quiet_basis(state)}")
     if state.last_query_scene_id is not None and state.last_query_scene_id == state.scene_id:
         return f"Nothing to ask: the scene hasn't changed since my last question ({numbers})."
     return f"Nothing to ask: no question is worth its cost now ({numbers})."

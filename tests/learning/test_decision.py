@@ -54,7 +54,12 @@ def test_expected_features_follow_each_query_into_the_next_turn():
     candidates = expected_decision_features(state)
     current = state_features(state)
     np.testing.assert_allclose(candidates.current, current)
-    np.testing.assert_allclose(candidates.expected[-1], current)  # no query: U(s) itself (eq. 6.3)
+    quiet = candidates.expected[-1]  # no query is scored at s_{t+1} too (eq. 7.1): the clock moves on
+    np.testing.assert_allclose(quiet[:BUDGET], current[:BUDGET])  # nothing learned by staying quiet
+    assert quiet[BUDGET] == pytest.approx(state.spent / state.budget)
+    assert quiet[TIME] == pytest.approx((state.turns - state.turn - 1) / state.turns)
+    window = state.change_every
+    assert quiet[QUIET] == pytest.approx(min(3, window) / window)  # two quiet turns so far, and this one
     for action, row in zip(candidates.actions[:-1], candidates.expected[:-1]):
         assert row[BUDGET] == pytest.approx((state.spent + state.cost(action)) / state.budget)
         assert row[TIME] == pytest.approx((state.turns - state.turn - 1) / state.turns)

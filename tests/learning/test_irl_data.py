@@ -182,7 +182,7 @@ def _json_document(tmp_path):
 
 @pytest.mark.parametrize("change, message", [
     (lambda d: d.update(format="something-else"), "not a demonstration file"),
-    (lambda d: d.update(version=9), "version 9 is not supported; accepted: 1"),
+    (lambda d: d.update(format_version=9), "version 9 is not supported; accepted: 2"),
     (lambda d: d.pop("feature_names"), "missing field 'feature_names'"),
     (lambda d: d.update(episodes=[]), "non-empty list"),
     (lambda d: d["episodes"][0].update(extra=1), "unknown field 'extra'"),
