@@ -5,7 +5,8 @@ strategy whose ``choose`` computes every candidate action and its expected
 decision features exactly as the DT strategy does at run time
 (``learning.decision.candidates.expected_decision_features`` with the same what-if engine
 and window), hands them to a *chooser* (``dialog.expert_terminal.PersonChooser``
-or ``dialog.scripted_expert.ScriptedExpertChooser``), and records the turn as
+or ``dialog.scripted_expert.ScriptedExpertChooser``, the rules of the ``scripted-expert``
+strategy), and records the turn as
 an IRL ``DecisionTurn`` (Phi of every candidate, the chosen row). A scripted
 teacher answers through the manager as in any episode. A chooser ends the
 session early by raising ``ExpertQuit``.
@@ -162,12 +163,14 @@ def output_paths(out_dir: str | Path, name: str) -> tuple[Path, Path]:
 
 
 def run_expert_episode(settings: ExpertSettings, chooser: Chooser, out_dir: str | Path, environment=None,
-                       say=print, observers: tuple = ()) -> ExpertOutcome:
+                       say=print, observers: tuple = (), name: str | None = None,
+                       metadata: dict | None = None) -> ExpertOutcome:
     """Play one episode with ``chooser`` picking the questions and a scripted teacher answering; save both files.
 
-    ``environment`` defaults to a SimulatedKitchen for the settings (closed afterwards).
+    ``environment`` defaults to a SimulatedKitchen for the settings (closed afterwards); ``name`` to
+    ``settings.name(chooser.name)``; ``metadata`` is added to the demonstration's (e.g. where its scenes came from).
     """
-    name = settings.name(chooser.name)
+    name = name or settings.name(chooser.name)
     demonstration, transcript_path = output_paths(out_dir, name)
     owned = environment is None
     if owned:
@@ -196,9 +199,9 @@ def run_expert_episode(settings: ExpertSettings, chooser: Chooser, out_dir: str 
     if not strategy.turns:
         transcript_path.unlink(missing_ok=True)
         raise ExpertQuit("the session ended before the first choice; nothing was saved")
-    metadata = {**settings.metadata(), "expert": chooser.name, "completed": len(strategy.turns),
+    recorded = {**settings.metadata(), **(metadata or {}), "expert": chooser.name, "completed": len(strategy.turns),
                 "quit": result.quit, "accuracy": round(result.accuracy, 6), "budget_spent": result.budget_spent,
                 "transcript": transcript_path.name}
-    episode = strategy.episode(name, metadata)
+    episode = strategy.episode(name, recorded)
     save_episodes(demonstration, [episode])
     return ExpertOutcome(episode, result, demonstration, transcript_path)

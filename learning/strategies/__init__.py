@@ -13,6 +13,7 @@ dt         DT with the weights in learning/decision/presets/dt.toml (or ``weight
 dt-iros    DT on ACD and CDU (thesis ch. 6)
 dt-task    DT on ACD, CDU, IV and PM (thesis ch. 7)
 dt-task-env DT on all seven decision features (thesis ch. 7; IRL weights)
+scripted-expert the scripted expert of thesis §7.4.1 (rules in data/scripted-expert.toml)
 ========== ==================================================================
 """
 
@@ -29,6 +30,7 @@ from learning.strategies.decision_theoretic import DecisionTheoreticStrategy
 from learning.strategies.hfs import HfsActiveStrategy, HfsPassiveStrategy
 from learning.strategies.passive import PassiveStrategy
 from learning.strategies.random_choice import RandomStrategy
+from learning.strategies.scripted_expert import ScriptedExpertStrategy
 
 STRATEGIES: dict[str, Callable[..., Strategy]] = {
     "passive": PassiveStrategy,
@@ -41,6 +43,7 @@ STRATEGIES: dict[str, Callable[..., Strategy]] = {
     "dt-iros": partial(DecisionTheoreticStrategy, "dt-iros"),
     "dt-task": partial(DecisionTheoreticStrategy, "dt-task"),
     "dt-task-env": partial(DecisionTheoreticStrategy, "dt-task-env"),
+    "scripted-expert": ScriptedExpertStrategy,
 }
 STRATEGY_NAMES = tuple(STRATEGIES)
 

@@ -62,8 +62,9 @@ def test_recorded_features_are_what_the_dt_strategy_computes(tmp_path):
     assert saved.metadata["engine"] == "fast" and saved.metadata["budget"] == 15.0
     first = saved.turns[0]
     assert first.kinds[-1] == "none" and first.labels[-1] == "no query"
-    state_row = first.phi[-1]  # no query keeps phi(s): one turn more of remaining time than any query
-    assert all(math.isclose(state_row[5] - row[5], 1 / 12) for row in first.phi[:-1])
+    quiet_row = first.phi[-1]  # eq. 7.1: no query is scored at s_{t+1} too, so time passes whatever is asked
+    assert all(math.isclose(quiet_row[5], row[5]) for row in first.phi[:-1])
+    assert quiet_row[6] > 0 and all(row[6] == 0 for row in first.phi[:-1])  # only a quiet turn adds quiet time
 
 
 def test_quitting_keeps_the_turns_so_far(tmp_path):
@@ -110,3 +111,51 @@ def test_person_commands_are_parsed_and_bad_ones_explained(tmp_path):
     chosen = [t.labels[t.chosen] for t in outcome.episode.turns]
     assert chosen[:4] == ["FSQ", "DQ(fruit)", "LQ(object 1)", "no query"]
     assert outcome.result.quit and len(load_episodes(outcome.demonstration)[0].turns) == 4  # end of input = quit
+
+
+def test_the_scripted_expert_strategy_asks_what_expert_mode_asks(tmp_path):
+    """One plan in two places: `scripted-expert` in the manager = `teachbot expert --expert scripted`."""
+    from dialog.manager import DialogManager, episode_generators
+    from dialog.teachers import ScriptedTeacher
+    from dialog.transcript import TranscriptWriter, read_transcript
+    from learning.strategies import make_strategy
+
+    recorded = scripted_episode(tmp_path, 7)
+    settings = ExpertSettings(seed=7, strategy="scripted-expert", **TRAINING)
+    rngs = episode_generators(settings.seed)
+    teacher = ScriptedTeacher(rngs["teacher"], 0.0, 0.0)
+    with TranscriptWriter(tmp_path / "strategy.jsonl") as transcript:
+        result = DialogManager(FakeEnvironment(objects=10), teacher, make_strategy("scripted-expert"),
+                               settings.config(), transcript, rngs, say=lambda text: None).run()
+    records = read_transcript(tmp_path / "strategy.jsonl")
+    kinds = [record["action"]["kind"] for record in records]
+    assert kinds == [turn.kinds[turn.chosen] for turn in recorded.episode.turns]
+    assert result.accuracy == pytest.approx(recorded.result.accuracy)
+    assert "feature" in kinds[:5] and kinds.count("label") > kinds.count("demo")
+
+
+def test_shipped_demonstrations_are_the_suite_episodes_of_the_expert_strategy(tmp_path):
+    """scripts/make_expert_demos.py plays the ch7-training condition on its data sets, as `regress` does."""
+    import importlib.util
+    from dataclasses import replace
+    from pathlib import Path
+
+    from dialog.experiments.episodes import run_episode
+    from dialog.experiments.suite import load_suite
+
+    path = Path(__file__).resolve().parents[2] / "scripts" / "make_expert_demos.py"
+    spec_of = importlib.util.spec_from_file_location("make_expert_demos", path)
+    script = importlib.util.module_from_spec(spec_of)
+    spec_of.loader.exec_module(script)
+    suite = load_suite("ch7-training")
+    spec = script.episode_spec(suite, 6, suite.data_seed)
+    assert (spec.dataset, spec.episode_seed, spec.data_seed) == (6 % suite.datasets, 6000 + 6 % suite.datasets, 100)
+    outcome = script.make_demo(spec, tmp_path / "demos")
+    saved = load_episodes(outcome.demonstration)[0]
+    assert saved.name == "scripted-expert-prepare-lunch-seed6" and len(saved.turns) == 30
+    assert saved.metadata["data_seed"] == 100 and saved.metadata["dataset"] == spec.dataset
+    episode = run_episode(replace(spec, transcript=str(tmp_path / "suite.jsonl")))
+    chosen = [turn.kinds[turn.chosen] for turn in saved.turns]
+    questions = {kind: chosen.count(kind) for kind in ("label", "demo", "feature")}
+    assert all(episode["series"][kind][-1] == count for kind, count in questions.items())
+    assert episode["accuracy"] == pytest.approx(outcome.result.accuracy)

@@ -1,0 +1,57 @@
+"""The MaxEnt policy as a strategy: actions sampled from P(a|s) ~ exp(w . Phi[a]) (thesis eq. 7.5, 7.7).
+
+IRL's learner plays its rollouts with this strategy. Each turn it computes the
+candidates and E[phi(s') | a] exactly as the DT strategy does
+(``learning.decision.candidates.expected_decision_features``), draws one
+action from the MaxEnt policy with its own ``numpy.random.Generator``, and
+records the turn as an IRL ``DecisionTurn``, so the rollout's feature counts
+are comparable with those of the expert's demonstrations.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from learning.actions import Decision
+from learning.decision.candidates import expected_decision_features
+from learning.decision.features import FEATURE_NAMES
+from learning.irl.demonstrations import DecisionTurn, QuestioningEpisode
+from learning.irl.policy import policy_probabilities
+from learning.state import LearningState
+from learning.strategies.base import Strategy
+from learning.whatif import make_engine
+
+
+class MaxEntPolicyStrategy(Strategy):
+    """Samples each turn's action from the MaxEnt policy with weights ``weights`` (FEATURE_NAMES order)."""
+
+    name = "maxent-policy"
+
+    def __init__(self, weights, rng: np.random.Generator, engine="fast", window_factor: float = 1.0):
+        weights = np.asarray(weights, dtype=np.float64)
+        if weights.shape != (len(FEATURE_NAMES),) or not np.all(np.isfinite(weights)):
+            raise ValueError(f"the MaxEnt policy needs {len(FEATURE_NAMES)} finite weights ({', '.join(FEATURE_NAMES)})"
+                             f", got shape {weights.shape}")
+        if not isinstance(rng, np.random.Generator):
+            raise ValueError(f"the MaxEnt policy samples with a numpy Generator, got {type(rng).__name__}")
+        self.weights, self.rng = weights, rng
+        self.engine = make_engine(engine)
+        self.window_factor = window_factor
+        self.turns: list[DecisionTurn] = []
+
+    def choose(self, state: LearningState, rng: np.random.Generator) -> Decision:
+        """One action drawn from P(a|s, w); the episode's generator ``rng`` is left alone (the strategy has its own)."""
+        candidates = expected_decision_features(state, self.engine, self.window_factor)
+        if len(candidates.actions) == 1:
+            index, decision = 0, self.nothing_affordable(state)
+        else:
+            probabilities = policy_probabilities(candidates.expected, self.weights)
+            index = int(self.rng.choice(len(probabilities), p=probabilities))
+            decision = Decision(candidates.actions[index], f"Sampled from the MaxEnt policy (p = "
+                                                           f"{probabilities[index]:.3f}).")
+        self.turns.append(DecisionTurn(candidates.expected, index, candidates.kinds))
+        return decision
+
+    def episode(self, name: str = "", metadata: dict | None = None) -> QuestioningEpisode:
+        """The turns played so far as an IRL episode (what the rollout contributes to eq. 7.7)."""
+        return QuestioningEpisode(FEATURE_NAMES, tuple(self.turns), name, metadata or {})
