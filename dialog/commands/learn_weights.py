@@ -1,35 +1,69 @@
-"""``teachbot learn-weights``: DT-task-env weights from expert demonstrations by maximum-entropy IRL (thesis §7.3.2)."""
+"""``teachbot learn-weights``: DT-task-env weights from expert demonstrations by maximum-entropy IRL (thesis §7.3.2).
+
+``--method trajectory`` (default): the thesis's trajectory-level fit (eq. 7.7), the learner's feature counts from
+rollouts of the real dialog loop in the training condition (dialog.experiments.irl_rollouts), the iterate kept by
+the final accuracy of greedy episodes on validation seeds. ``--method per-turn``: the per-turn fits of
+learning.irl.maxent, kept by agreement with held-out demonstrations.
+"""
 
 from __future__ import annotations
 
 import argparse
 import json
+import subprocess
 import sys
+import time
 from pathlib import Path
 
-from dialog.commands._arguments import positive_int
+from dialog.commands._arguments import positive_int, seed
 from dialog.output_paths import check_writable, writing
-from learning.errors import OutputPathError
+from learning.errors import OutputPathError, SettingsError
+
+# Trajectory defaults: sized so that 100 iterations fit in about 10 minutes on a 2-core machine (docs/irl.md).
+ROLLOUTS_PER_ITERATION = 6
+VALIDATION_EPISODES = 8
+EVALUATE_EVERY = 2
+REPOSITORY = Path(__file__).resolve().parents[2]
 
 
 def register(commands) -> None:
     parser = commands.add_parser(
         "learn-weights", help="learn the DT-task-env decision-feature weights from expert demonstrations (IRL)",
         description="Fit maximum-entropy IRL (thesis eq. 7.5-7.7) to expert questioning episodes and write a "
-                    "weights file the DT strategies read. Episodes are split into training and validation; the "
-                    "iterate with the best validation agreement is kept.")
+                    "weights file the DT strategies read. By default the trajectory-level fit of eq. 7.7: the "
+                    "learner's feature counts come from rollouts of the dialog loop in the training condition, "
+                    "and the iterate whose greedy episodes end most accurate on validation seeds is kept.")
     parser.add_argument("--demos", required=True, metavar="DIR_OR_shipped",
                         help="a directory of .json/.npz demonstrations (teachbot expert --out), one such file, or "
                              "'shipped' (learning/irl/expert-demos)")
     parser.add_argument("--out", type=Path, required=True, metavar="FILE.toml", help="the weights file to write")
+    parser.add_argument("--method", choices=("trajectory", "per-turn"), default="trajectory",
+                        help="trajectory (default): eq. 7.7 with rollouts of the dialog loop; per-turn: the "
+                             "per-turn MaxEnt fit on the recorded candidates (see --policy)")
     parser.add_argument("--iterations", type=positive_int, default=100,
                         help="at most this many optimiser iterations (default 100, thesis §7.4.1)")
-    parser.add_argument("--seed", type=int, default=0, help="seed of the training/validation split (default 0)")
-    parser.add_argument("--validation", type=positive_int, default=None, metavar="N",
-                        help="episodes held out for validation (default: all but three, at least one)")
-    parser.add_argument("--policy", choices=("gated", "softmax"), default="gated",
-                        help="gated (default): ask-or-not, then which query, as the DT decides; softmax: one "
-                             "softmax over every candidate (docs/irl.md)")
+    parser.add_argument("--seed", type=seed, default=0,
+                        help="seed of the demonstration split and of the rollouts' sampling (default 0)")
+    trajectory = parser.add_argument_group("trajectory fit (--method trajectory)")
+    trajectory.add_argument("--train-episodes", type=positive_int, default=3, metavar="N",
+                            help="demonstrations to train on (default 3, as the thesis); the rest are held out")
+    trajectory.add_argument("--rollouts", type=positive_int, default=ROLLOUTS_PER_ITERATION, metavar="N",
+                            help=f"learner episodes per iteration (default {ROLLOUTS_PER_ITERATION})")
+    trajectory.add_argument("--validation-episodes", type=positive_int, default=VALIDATION_EPISODES, metavar="N",
+                            help=f"greedy episodes on validation seeds that score an iterate (default "
+                                 f"{VALIDATION_EPISODES})")
+    trajectory.add_argument("--evaluate-every", type=positive_int, default=EVALUATE_EVERY, metavar="K",
+                            help=f"score every K-th iterate and the last (default {EVALUATE_EVERY})")
+    trajectory.add_argument("--workers", type=positive_int, default=None,
+                            help="local worker processes for the rollouts (default: cores)")
+    trajectory.add_argument("--ray", metavar="ADDRESS", default=None,
+                            help="play the rollouts on the Ray cluster at ADDRESS ('local' starts one here)")
+    per_turn = parser.add_argument_group("per-turn fit (--method per-turn)")
+    per_turn.add_argument("--validation", type=positive_int, default=None, metavar="N",
+                          help="episodes held out for validation (default: all but three, at least one)")
+    per_turn.add_argument("--policy", choices=("gated", "softmax"), default="gated",
+                          help="gated (default): ask-or-not, then which query, as the DT decides; softmax: one "
+                               "softmax over every candidate (docs/irl.md)")
     parser.add_argument("--json", action="store_true", help="end with one JSON line: iterations, seconds, weights, "
                                                              "validation_agreement")
     parser.set_defaults(handler=run)
@@ -37,17 +71,44 @@ def register(commands) -> None:
 
 def run(args: argparse.Namespace, output_stream=None) -> int:
     from learning.decision.weights_file import save_weights
-    from learning.irl.learn import learn_weights, weights_comment
+    from learning.irl.learn import weights_comment
 
     out = output_stream or sys.stdout
     if args.out.suffix != ".toml":
         raise OutputPathError(f"--out {args.out}: a weights file must end in .toml")
     if not args.out.parent.exists():
         raise OutputPathError(f"--out {args.out}: the directory {args.out.parent} does not exist")
+    method = getattr(args, "method", "per-turn")
+    check_options(args, method)
     check_writable(args.out, "weights file")  # before the fit, which takes a while
-    learned = learn_weights(args.demos, args.iterations, args.seed, args.validation, args.policy)
+    learned = learn_trajectory(args, out) if method == "trajectory" else learn_per_turn(args, out)
     with writing(args.out, "weights file"):
         save_weights(args.out, learned.weights, weights_comment(learned))
+    for name, value in learned.weights.as_dict().items():
+        note = "  (unidentified: equal on every candidate)" if name in learned.result.unidentified_features else ""
+        print(f"  {name:<30} {value:>12.4f}{note}", file=out)
+    print(f"wrote {args.out}", file=out)
+    if args.json:
+        print(json.dumps(learned.summary()), file=out, flush=True)
+    return 0
+
+
+def check_options(args: argparse.Namespace, method: str) -> None:
+    """Options of the other method are refused rather than silently ignored."""
+    given = {"trajectory": [("--validation", getattr(args, "validation", None) is not None),
+                            ("--policy", getattr(args, "policy", "gated") != "gated")],
+             "per-turn": [("--ray", getattr(args, "ray", None) is not None),
+                          ("--workers", getattr(args, "workers", None) is not None)]}[method]
+    wrong = [name for name, present in given if present]
+    if wrong:
+        raise SettingsError(f"{', '.join(wrong)} do(es) not apply to --method {method}; see teachbot learn-weights "
+                            "--help for the options of each method")
+
+
+def learn_per_turn(args: argparse.Namespace, out):
+    from learning.irl.learn import learn_weights
+
+    learned = learn_weights(args.demos, args.iterations, args.seed, args.validation, args.policy)
     result, provenance = learned.result, learned.weights.provenance
     print(f"{len(learned.train)} training episodes ({result.train_turns} turns with a choice), "
           f"{len(learned.validation)} validation ({result.validation_turns} turns); {result.iterations} iterations, "
@@ -57,10 +118,66 @@ def run(args: argparse.Namespace, output_stream=None) -> int:
           f"{result.validation_agreement:.3f} (asks or stays quiet alike: "
           f"{provenance.get('validation_ask_or_quiet_agreement', float('nan')):.3f}, same kind of action: "
           f"{provenance.get('validation_action_kind_agreement', float('nan')):.3f})", file=out)
-    for name, value in learned.weights.as_dict().items():
-        note = "  (unidentified: equal on every candidate)" if name in result.unidentified_features else ""
-        print(f"  {name:<30} {value:>12.4f}{note}", file=out)
-    print(f"wrote {args.out}", file=out)
-    if args.json:
-        print(json.dumps(learned.summary()), file=out, flush=True)
-    return 0
+    return learned
+
+
+def git_commit() -> str:
+    """The repository's HEAD commit, or "unknown" outside a git checkout."""
+    try:
+        done = subprocess.run(["git", "rev-parse", "HEAD"], cwd=REPOSITORY, capture_output=True, text=True,
+                              timeout=10, check=False)
+    except (OSError, subprocess.SubprocessError):
+        return "unknown"
+    commit = done.stdout.strip()
+    return commit if done.returncode == 0 and len(commit) == 40 else "unknown"
+
+
+def learn_trajectory(args: argparse.Namespace, out):
+    from dialog.experiments.irl_rollouts import (
+        RolloutPool,
+        rollout_functions,
+        training_condition,
+        training_seed,
+        validation_seeds,
+    )
+    from learning.irl.learn import learn_trajectory_weights
+    from learning.irl.rollouts import FeatureMatchingConfig
+
+    started = time.perf_counter()
+    condition = training_condition()
+    held_out = validation_seeds(args.validation_episodes)
+    config = FeatureMatchingConfig(max_iterations=args.iterations, rollouts_per_iteration=args.rollouts,
+                                   seed=args.seed, evaluate_every=args.evaluate_every)
+    last_seed = training_seed(args.iterations, args.rollouts - 1, args.rollouts)
+    context = {"commit": git_commit(), **condition.provenance(),
+               "training_rollout_seeds": f"{training_seed(1, 0, args.rollouts)}-{last_seed}",
+               "validation_seeds": f"{held_out[0]}-{held_out[-1]}"}
+    c = condition.condition
+    print(f"trajectory MaxEnt IRL (eq. 7.7): {condition.task}/{condition.kitchen}, budget {c.budget:g}, {c.turns} "
+          f"turns, a change every {c.change_every}, data seed {condition.data_seed} ({condition.source}); "
+          f"{args.rollouts} rollouts an iteration, {len(held_out)} validation episodes every "
+          f"{args.evaluate_every} iteration(s)", file=out, flush=True)
+    best = {"score": None, "iteration": 0}
+
+    def progress(record, seconds: float) -> None:
+        if record.evaluation is not None and (best["score"] is None or record.evaluation > best["score"]):
+            best.update(score=record.evaluation, iteration=record.iteration)
+        scored = "" if record.evaluation is None else f", validation accuracy {record.evaluation:.3f}"
+        gap = "" if record.iteration == 0 else f"gap {record.loss:.3f}, "
+        agreement = record.validation_agreement if record.validation_agreement is not None else float("nan")
+        print(f"iteration {record.iteration:>3}/{args.iterations}: {gap}held-out agreement {agreement:.3f}"
+              f"{scored} (best {best['score'] or 0:.3f} at {best['iteration']}); {seconds:.0f} s",
+              file=out, flush=True)
+
+    with RolloutPool(args.workers, args.ray) as pool:
+        context["rollouts_on"] = pool.where
+        rollouts, evaluate = rollout_functions(condition, pool, args.seed, args.validation_episodes)
+        learned = learn_trajectory_weights(args.demos, rollouts, evaluate, config, args.train_episodes, context,
+                                           progress)
+    result, provenance = learned.result, learned.weights.provenance
+    print(f"kept iteration {result.best_iteration} of {result.iterations}: validation accuracy "
+          f"{provenance['validation_accuracy']:.3f}; on the {len(learned.validation)} held-out demonstration(s) "
+          f"({result.validation_turns} turns) agreement {result.validation_agreement:.3f}, log-likelihood "
+          f"{result.validation_log_likelihood:.3f} a turn; total {time.perf_counter() - started:.0f} s",
+          file=out, flush=True)
+    return learned

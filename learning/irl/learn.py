@@ -1,11 +1,16 @@
 """``teachbot learn-weights``: DT-task-env weights from expert demonstrations (thesis §7.3.2, §7.4.1).
 
 Load the demonstrations (a directory of .json/.npz files, one file, or the
-shipped ones in learning/irl/expert-demos/), hold out whole episodes for
-validation (by default all but three train, as the thesis trained on three
-expert episodes; at least one validates), fit per-turn maximum-entropy IRL
-(``learning.irl.maxent.fit_maxent_irl``, eq. 7.5-7.7, at most 100 iterations) and keep
-the iterate that does best on the validation episodes.
+shipped ones in learning/irl/expert-demos/) and hold out whole episodes
+(three train, as in the thesis; the rest are held out). Two fits:
+
+* ``learn_trajectory_weights`` (the default of ``teachbot learn-weights``): the
+  thesis's trajectory-level MaxEnt IRL (eq. 7.7, ``learning.irl.rollouts``) with
+  rollouts and validation episodes supplied by the caller (the dialog loop:
+  dialog.experiments.irl_rollouts); the iterate best on the validation episodes
+  is kept, agreement and likelihood on the held-out demonstrations reported.
+* ``learn_weights``: per-turn MaxEnt IRL (``learning.irl.maxent``), kept by
+  agreement with the held-out demonstrations.
 """
 
 from __future__ import annotations
@@ -121,7 +126,68 @@ def learn_weights(demos: str | Path, iterations: int = 100, seed: int = 0,
     return LearnedWeights(weights, result, train, validation, time.perf_counter() - started)
 
 
+def demonstration_files(spec: str | Path) -> str:
+    """The demonstration file names behind ``--demos`` (for the provenance)."""
+    path = SHIPPED_DEMOS if str(spec) == SHIPPED else Path(spec)
+    if path.is_dir():
+        return ", ".join(sorted(p.name for p in path.iterdir() if p.suffix in (".json", ".npz") and p.is_file()))
+    return path.name
+
+
+def learn_trajectory_weights(demos: str | Path, rollouts, evaluate, config,
+                             train_episodes: int = THESIS_TRAINING_EPISODES, context: dict | None = None,
+                             progress=None) -> LearnedWeights:
+    """Trajectory-level MaxEnt IRL (eq. 7.7) on ``train_episodes`` demonstrations, the rest held out.
+
+    ``rollouts(w, iteration, count)`` plays the learner's episodes, ``evaluate(w)`` scores an iterate on
+    validation episodes (``learning.irl.rollouts.fit_feature_matching``); ``config`` is its
+    FeatureMatchingConfig (its seed also picks the training demonstrations). ``context`` (training
+    condition, seeds, commit, ...) goes into the provenance.
+    """
+    started = time.perf_counter()
+    from learning.irl.maxent import split_episodes
+    from learning.irl.rollouts import fit_feature_matching
+
+    episodes = load_demonstrations(demos)
+    if isinstance(train_episodes, bool) or not isinstance(train_episodes, int) or not 1 <= train_episodes < len(
+            episodes):
+        raise SettingsError(f"--train-episodes must be in 1..{len(episodes) - 1} (at least one of the "
+                            f"{len(episodes)} demonstrations is held out), got {train_episodes!r}")
+    train, held_out = split_episodes(episodes, len(episodes) - train_episodes, np.random.default_rng(config.seed))
+    result = fit_feature_matching(train, rollouts, held_out, config, evaluate=evaluate, progress=progress)
+    kept = result.history[result.best_iteration]
+    assert kept.evaluation is not None and result.validation_agreement is not None, \
+        "the kept iterate was evaluated and there are held-out demonstrations"
+    assert result.validation_log_likelihood is not None, "held-out demonstrations give a likelihood"
+    diagnostics = decision_agreement(held_out, result.weights.values)
+    provenance = {"method": "maxent-irl-trajectory",
+                  "gradient": "eq. 7.7: expert minus rollout feature counts per turn",
+                  "optimizer": "adam", "learning_rate": config.learning_rate, "l2": config.l2,
+                  "select_by": "mean final accuracy of greedy DT episodes on the validation seeds",
+                  "commit": (context or {}).get("commit", "unknown"),
+                  "demos": SHIPPED if str(demos) == SHIPPED else str(demos),
+                  "demonstrations": demonstration_files(demos),
+                  "train_episodes": ", ".join(e.name for e in train),
+                  "held_out_episodes": ", ".join(e.name for e in held_out), "seed": config.seed,
+                  **{k: v for k, v in (context or {}).items() if k != "commit"},
+                  "rollouts_per_iteration": config.rollouts_per_iteration, "evaluate_every": config.evaluate_every,
+                  "max_iterations": config.max_iterations, "iterations": result.iterations,
+                  "best_iteration": result.best_iteration, "validation_accuracy": round(kept.evaluation, 6),
+                  "held_out_turns": result.validation_turns,
+                  "held_out_agreement": round(result.validation_agreement, 6),
+                  "held_out_log_likelihood": round(result.validation_log_likelihood, 6),
+                  **{f"held_out_{key}": round(value, 6) for key, value in diagnostics.items()},
+                  "train_agreement": round(result.train_agreement, 6),
+                  "unidentified_features": ", ".join(result.unidentified_features) or "none"}
+    weights = DecisionWeights(result.weights.feature_names, result.weights.values, provenance)
+    return LearnedWeights(weights, result, train, held_out, time.perf_counter() - started)
+
+
 def weights_comment(learned: LearnedWeights) -> str:
+    if learned.weights.provenance.get("method") == "maxent-irl-trajectory":
+        return (f"DT-task-env weights (thesis eq. 7.2) learned by trajectory-level maximum-entropy IRL (eq. 7.7) "
+                f"from {len(learned.train)} expert episodes,\nthe iterate whose greedy episodes did best on the "
+                f"validation seeds. Written by `teachbot learn-weights`; docs/irl.md.")
     return (f"DT-task-env weights (thesis eq. 7.2) learned by maximum-entropy IRL (eq. 7.5-7.7) from "
             f"{len(learned.train)} expert episodes,\nthe iterate best on {len(learned.validation)} held-out "
             f"episode(s). Written by `teachbot learn-weights`; docs/irl.md.")

@@ -190,12 +190,14 @@ class AdamAscent:
 @dataclass(frozen=True)
 class IterationRecord:
     """One iteration (0 = the start) and both agreements. ``loss`` is the training objective of the
-    per-turn fit, or the norm of the feature-count gap (eq. 7.7) in feature matching."""
+    per-turn fit, or the norm of the feature-count gap (eq. 7.7) in feature matching, where
+    ``evaluation`` is the iterate's held-out score when it was evaluated (else None)."""
 
     iteration: int
     loss: float
     train_agreement: float
     validation_agreement: float | None
+    evaluation: float | None = None
 
 
 @dataclass(frozen=True, eq=False)

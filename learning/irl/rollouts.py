@@ -8,9 +8,10 @@ learner's expected feature counts,
 where a trajectory's counts are the sum over its turns of the features of the
 chosen action (thesis §2.5.2). The expectation is estimated from episodes the
 learner plays itself with the MaxEnt policy P(a|s) ~ exp(w . Phi[a]): the
-caller supplies that as a ``rollout(weights, rng) -> QuestioningEpisode``
-function (the dialog loop with a scripted teacher, or a synthetic
-environment), and picks each action with ``learning.irl.policy.sample_choice``. Unlike the
+caller supplies them as ``rollouts(weights, iteration, count)`` (the dialog
+loop with a scripted teacher, dialog.experiments.irl_rollouts, possibly in
+parallel; or ``serial_rollouts`` around a synthetic environment), each action
+drawn from that policy with a generator seeded by (seed, iteration, rollout). Unlike the
 per-turn fit in ``learning.irl.maxent`` this sees the states the learner's own
 choices lead to, at the price of simulating episodes every iteration.
 Counts are divided by the number of turns, so episodes of any length mix.
@@ -36,8 +37,13 @@ from learning.irl.maxent import (
     log_likelihood,
     make_result,
 )
+from learning.irl.policy import policy_probabilities
 
-Rollout = Callable[[np.ndarray, np.random.Generator], QuestioningEpisode]
+Rollout = Callable[[np.ndarray, np.random.Generator], QuestioningEpisode]  # one episode with weights w
+# (weights, iteration, count) -> that iteration's ``count`` episodes; the caller may play them in parallel
+RolloutBatch = Callable[[np.ndarray, int, int], Sequence[QuestioningEpisode]]
+Evaluate = Callable[[np.ndarray], float]  # a score of weights on held-out episodes, higher is better
+Progress = Callable[[IterationRecord, float], None]  # (this iteration's record, seconds since the start)
 
 
 @dataclass(frozen=True)
@@ -51,9 +57,12 @@ class FeatureMatchingConfig:
     standardize: bool = True
     seed: int = 0
     threads: int = 1  # torch and BLAS threads during the fit, rollouts included
+    evaluate_every: int = 1  # with ``evaluate``: score every k-th iterate (and the last)
+    optimizer: str = "adam"  # or "gradient": plain ascent along the gap, x += learning_rate * gap
+    expected_counts: bool = True  # learner's counts: the policy's expectation at each visited state (else sampled)
 
     def __post_init__(self) -> None:
-        for name in ("max_iterations", "rollouts_per_iteration"):
+        for name in ("max_iterations", "rollouts_per_iteration", "evaluate_every"):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int) or value < 1:
                 raise ValueError(f"{name} must be an integer >= 1, got {value!r}")
@@ -67,32 +76,59 @@ class FeatureMatchingConfig:
             raise ValueError("learning_rate must be > 0")
 
 
+def rollout_generator(seed: int, iteration: int, index: int) -> np.random.Generator:
+    """The policy's generator for rollout ``index`` of ``iteration``: the same numbers wherever it runs."""
+    return np.random.default_rng(np.random.SeedSequence([int(seed), int(iteration), int(index)]))
+
+
+def serial_rollouts(rollout: Rollout, seed: int = 0) -> RolloutBatch:
+    """A batch of rollouts played one after another here, each with its own seeded generator."""
+    def batch(weights: np.ndarray, iteration: int, count: int) -> list[QuestioningEpisode]:
+        return [rollout(weights, rollout_generator(seed, iteration, index)) for index in range(count)]
+    return batch
+
+
 def mean_feature_counts(episodes: Sequence[QuestioningEpisode]) -> np.ndarray:
     """Mean over episodes of phi(tau) / |tau|: the per-turn feature counts of eq. 7.6."""
     return np.mean([episode.feature_counts() / len(episode.turns) for episode in episodes], axis=0)
 
 
-def fit_feature_matching(expert: Sequence[QuestioningEpisode], rollout: Rollout,
+def mean_expected_feature_counts(episodes: Sequence[QuestioningEpisode], weights: np.ndarray) -> np.ndarray:
+    """Like ``mean_feature_counts``, but each turn counts sum_a P(a|s_t, w) Phi_t[a] instead of the sampled row.
+
+    The same expectation as the sampled counts (the policy's choice averaged out at every state the
+    rollout visited), with less variance: the estimate of eq. 7.7's learner term when the rollouts
+    were played with ``weights``.
+    """
+    per_episode = [np.sum([policy_probabilities(turn.phi, weights) @ turn.phi for turn in episode.turns], axis=0)
+                   / len(episode.turns) for episode in episodes]
+    return np.mean(per_episode, axis=0)
+
+
+def fit_feature_matching(expert: Sequence[QuestioningEpisode], rollouts: RolloutBatch,
                          validation: Sequence[QuestioningEpisode] | None = None,
                          config: FeatureMatchingConfig | None = None,
-                         initial_weights: np.ndarray | None = None) -> IrlResult:
+                         initial_weights: np.ndarray | None = None, evaluate: Evaluate | None = None,
+                         progress: Progress | None = None) -> IrlResult:
     """Learn w so that the learner's rollouts match the expert's feature counts (eq. 7.6, 7.7).
 
     Each iteration plays ``rollouts_per_iteration`` episodes with the current
-    weights. The kept weights are those whose greedy choices agree best with
-    the validation episodes (without them: with the expert episodes); ties go
-    to the higher log-likelihood, then to the earlier iteration.
+    weights (``rollouts(w, iteration, count)``). With ``evaluate`` the kept
+    weights are the evaluated iterate with the highest score (the thesis: the
+    best on held-out validation episodes), ties to the higher agreement with the
+    validation demonstrations, then to the earlier iteration. Without it: the
+    iterate whose greedy choices agree best with the validation episodes
+    (without them: the expert episodes), ties to the higher log-likelihood.
     """
     config = config or FeatureMatchingConfig()
     with compute_threads(config.threads):
-        return _fit_feature_matching(expert, rollout, validation, config, initial_weights)
+        return _fit_feature_matching(expert, rollouts, validation, config, initial_weights, evaluate, progress)
 
 
-def _fit_feature_matching(expert, rollout: Rollout, validation, config: FeatureMatchingConfig,
-                          initial_weights) -> IrlResult:
+def _fit_feature_matching(expert, rollouts: RolloutBatch, validation, config: FeatureMatchingConfig,
+                          initial_weights, evaluate: Evaluate | None, progress: Progress | None) -> IrlResult:
     started = time.perf_counter()
     torch.manual_seed(config.seed)
-    rng = np.random.default_rng(config.seed)
     train_turns = PaddedTurns(expert, "expert episodes")
     names = train_turns.feature_names
     validation_turns = PaddedTurns(validation, "validation episodes") if validation else None
@@ -105,28 +141,54 @@ def _fit_feature_matching(expert, rollout: Rollout, validation, config: FeatureM
     if w0.shape != (len(names),) or not np.all(np.isfinite(w0)):
         raise ValueError(f"initial_weights must be {len(names)} finite numbers, got shape {w0.shape}")
     adam, x = AdamAscent(config.learning_rate), w0 * scale
+    held_out = validation_turns if validation_turns is not None else train_turns
 
-    def score(w: np.ndarray) -> tuple[float, float | None, tuple]:
+    def record(iteration: int, gap: float, w: np.ndarray) -> tuple[IterationRecord, tuple | None]:
+        """The iteration's scores and its selection key (None: not evaluated this iteration)."""
         train_agreement = train_turns.agreement(w)
-        if validation_turns is None:
-            return train_agreement, None, (train_agreement, log_likelihood(train_turns, w))
-        validation_agreement = validation_turns.agreement(w)
-        return train_agreement, validation_agreement, (validation_agreement, log_likelihood(validation_turns, w))
+        validation_agreement = validation_turns.agreement(w) if validation_turns is not None else None
+        agreement_key = held_out.agreement(w)
+        if evaluate is None:
+            return (IterationRecord(iteration, gap, train_agreement, validation_agreement),
+                    (agreement_key, log_likelihood(held_out, w)))
+        due = iteration % config.evaluate_every == 0 or iteration == config.max_iterations
+        if not due:
+            return IterationRecord(iteration, gap, train_agreement, validation_agreement), None
+        score = float(evaluate(w))
+        if not np.isfinite(score):
+            raise ValueError(f"the evaluation of iteration {iteration} returned {score}; it must be a finite number")
+        return IterationRecord(iteration, gap, train_agreement, validation_agreement, score), (score, agreement_key)
 
     best_w = w0.copy()
-    train_agreement, validation_agreement, best_key = score(best_w)
-    history, best_iteration = [IterationRecord(0, float("nan"), train_agreement, validation_agreement)], 0
+    first, best_key = record(0, float("nan"), best_w)
+    history, best_iteration = [first], 0
+    if progress is not None:
+        progress(first, time.perf_counter() - started)
     for iteration in range(1, config.max_iterations + 1):
-        episodes = [_checked(rollout(x / scale, rng), names) for _ in range(config.rollouts_per_iteration)]
-        gap = expert_counts - mean_feature_counts(episodes) / scale  # eq. 7.7 in standardised units
-        x = adam.step(x, (gap - config.l2 * x) * identifiable)
+        episodes = [_checked(episode, names)
+                    for episode in rollouts(x / scale, iteration, config.rollouts_per_iteration)]
+        if len(episodes) != config.rollouts_per_iteration:
+            raise ValueError(f"iteration {iteration}: the rollouts returned {len(episodes)} episodes, "
+                             f"{config.rollouts_per_iteration} were asked for")
+        learner = (mean_expected_feature_counts(episodes, x / scale) if config.expected_counts
+                   else mean_feature_counts(episodes))
+        gap = expert_counts - learner / scale  # eq. 7.7 in standardised units
+        ascent = (gap - config.l2 * x) * identifiable
+        x = adam.step(x, ascent) if config.optimizer == "adam" else x + config.learning_rate * ascent
         w = x / scale
-        train_agreement, validation_agreement, key = score(w)
-        history.append(IterationRecord(iteration, float(np.linalg.norm(gap)), train_agreement, validation_agreement))
-        if key > best_key:
+        entry, key = record(iteration, float(np.linalg.norm(gap)), w)
+        history.append(entry)
+        if key is not None and (best_key is None or key > best_key):
             best_key, best_w, best_iteration = key, w, iteration
-    settings = {"method": "maxent-irl-feature-matching", "optimizer": "adam", "l2": float(config.l2),
-                "rollouts_per_iteration": config.rollouts_per_iteration}
+        if progress is not None:
+            progress(entry, time.perf_counter() - started)
+    settings = {"method": "maxent-irl-feature-matching", "optimizer": config.optimizer, "l2": float(config.l2),
+                "learning_rate": float(config.learning_rate),
+                "rollouts_per_iteration": config.rollouts_per_iteration,
+                "learner_counts": "expected under the policy" if config.expected_counts else "sampled",
+                "select_by": "evaluation" if evaluate is not None else "agreement"}
+    if evaluate is not None:
+        settings["evaluate_every"] = config.evaluate_every
     return make_result(names, best_w, identifiable, history, best_iteration, config.max_iterations, False, settings,
                        train_turns, validation_turns, started)
 

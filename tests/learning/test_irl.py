@@ -15,11 +15,12 @@ from learning.irl.maxent import (
     split_episodes,
 )
 from learning.irl.policy import agreement, greedy_choice
-from learning.irl.rollouts import FeatureMatchingConfig, fit_feature_matching
+from learning.irl.rollouts import FeatureMatchingConfig, fit_feature_matching, serial_rollouts
 from learning.irl.synthetic import DT_TASK_ENV_FEATURES, SyntheticQuestioningTask, greedy_policy, softmax_policy
 
-# a DT-task-env-like expert: wants learning progress, dislikes spending, dislikes sitting idle
-TRUE_WEIGHTS = np.array([1.0, 0.6, 0.4, 1.2, -1.5, 0.0, 0.8])
+# a DT-task-env-like expert: wants learning progress, dislikes spending, dislikes sitting idle (the no-query
+# row is at the next state, eq. 7.1, so non-query time rises when it stays quiet)
+TRUE_WEIGHTS = np.array([1.0, 0.6, 0.4, 1.2, -1.5, 0.0, -0.4])
 TASK = SyntheticQuestioningTask()  # budget 15, 30 turns, a scene change every 10 turns (thesis §7.4.1)
 IDENTIFIABLE = np.array([name != "remaining_time" for name in DT_TASK_ENV_FEATURES])
 
@@ -221,24 +222,26 @@ def test_feature_matching_with_rollouts_learns_the_policy(dt_expert):
         return TASK.episode(softmax_policy(weights), rng)
 
     config = FeatureMatchingConfig(max_iterations=40, rollouts_per_iteration=2, seed=3)
-    result = fit_feature_matching(train, rollout, validation, config)
+    result = fit_feature_matching(train, serial_rollouts(rollout, seed=3), validation, config)
     assert result.iterations == 40 and len(result.history) == 41
-    assert agreement(test, result.weights.values) >= 0.85 > agreement(test, np.zeros(7))
+    # the mechanics on ten episodes and 40 iterations; the recovery target is in test_irl_trajectory.py
+    assert agreement(test, result.weights.values) >= 0.75 > 0.5 > agreement(test, np.zeros(7))
     assert cosine(result.weights.values, TRUE_WEIGHTS) > 0.7
     gaps = [record.loss for record in result.history[1:]]
     assert np.mean(gaps[-10:]) < 0.5 * np.mean(gaps[:5])  # the feature-count gap of eq. 7.7 closes
     assert result.weights.provenance["method"] == "maxent-irl-feature-matching"
-    again = fit_feature_matching(train, rollout, validation, config)
+    again = fit_feature_matching(train, serial_rollouts(rollout, seed=3), validation, config)
     assert again.weights.values.tobytes() == result.weights.values.tobytes()
 
 
 def test_a_rollout_must_return_a_matching_episode(dt_expert):
     train = dt_expert[0][:2]
     with pytest.raises(ValueError, match="must return a QuestioningEpisode, got dict"):
-        fit_feature_matching(train, lambda w, rng: {}, config=FeatureMatchingConfig(max_iterations=1))
+        fit_feature_matching(train, serial_rollouts(lambda w, rng: {}), config=FeatureMatchingConfig(max_iterations=1))
     other = QuestioningEpisode(("a", "b"), [DecisionTurn([[0.0, 1.0], [1.0, 0.0]], 0)])
     with pytest.raises(ValueError, match="a rollout episode has features"):
-        fit_feature_matching(train, lambda w, rng: other, config=FeatureMatchingConfig(max_iterations=1))
+        fit_feature_matching(train, serial_rollouts(lambda w, rng: other),
+                             config=FeatureMatchingConfig(max_iterations=1))
     with pytest.raises(ValueError, match="rollouts_per_iteration must be an integer >= 1"):
         FeatureMatchingConfig(rollouts_per_iteration=0)
 
