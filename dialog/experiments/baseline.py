@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from dialog.experiments.analysis import CheckpointSummary
-from dialog.experiments.suite import SUITE_DIR, Suite
+from dialog.experiments.suite import SUITE_DIR, Suite, SuiteError
 
 BASELINE_DIR = SUITE_DIR / "baselines"
 DEFAULT_TOLERANCE = 0.05
@@ -28,7 +28,7 @@ def make_baseline(suite: Suite, summaries: list[CheckpointSummary], tolerance: f
             entry[str(checkpoint)] = {"mean": round(float(mean), 4),
                                       "band": [round(float(mean) - half, 4), round(float(mean) + half, 4)]}
     return {"suite": suite.name, "axis": suite.axis, "seeds": list(suite.seeds), "datasets": suite.datasets,
-            "bands": bands}
+            "data_seed": suite.data_seed, "bands": bands}
 
 
 def write_baseline(suite: Suite, summaries: list[CheckpointSummary], path: Path | None = None) -> Path:
@@ -38,19 +38,37 @@ def write_baseline(suite: Suite, summaries: list[CheckpointSummary], path: Path 
     return path
 
 
+def refuse_other_data_seed(suite: Suite, path: Path | None = None) -> None:
+    """``--check`` compares like with like: a baseline made on data from another seed is refused (SuiteError)."""
+    path = path or baseline_path(suite)
+    try:
+        stored = json.loads(path.read_text(encoding="utf-8")).get("data_seed", 0)
+    except (OSError, json.JSONDecodeError, AttributeError):
+        return  # a missing or unreadable baseline is reported by check_against_baseline
+    if stored != suite.data_seed:
+        raise SuiteError(f"--check: the baseline {path} was made on the data sets of data seed {stored}, this run "
+                         f"uses data seed {suite.data_seed}; check with --data-seed {stored}, or run without --check")
+
+
 def check_against_baseline(suite: Suite, summaries: list[CheckpointSummary], path: Path | None = None) -> list[str]:
     """Readable differences for every checkpoint mean outside its stored band (empty: all inside)."""
     path = path or baseline_path(suite)
     if not path.exists():
         return [f"no stored baseline for suite '{suite.name}' at {path}; run with --update-baseline first"]
     try:
-        bands = json.loads(path.read_text(encoding="utf-8"))["bands"]
-    except (json.JSONDecodeError, KeyError) as error:
+        stored = json.loads(path.read_text(encoding="utf-8"))
+        bands, data_seed = stored["bands"], stored.get("data_seed", 0)
+    except (json.JSONDecodeError, KeyError, AttributeError, TypeError) as error:
         return [f"baseline {path} is unreadable ({error}); rewrite it with --update-baseline"]
+    if data_seed != suite.data_seed:
+        return [f"baseline {path} was made on data seed {data_seed}, this run on data seed {suite.data_seed}: "
+                "not comparable"]
     axis = suite.axis  # questions, turns or demonstrations
     failures = []
     for s in summaries:
         stored = bands.get(s.condition, {}).get(s.strategy)
+        if stored is None and s.strategy in suite.weights:
+            continue  # a --weights strategy: the user's own, no baseline to hold it to
         if stored is None:
             failures.append(f"{s.strategy}/{s.condition}: not in the baseline")
             continue

@@ -21,7 +21,7 @@ class EpisodesKind(SuiteKind):
 
     def load(self, suite: Suite) -> Suite:
         where = suite.path or suite.name
-        unknown = [s for s in suite.strategies if s not in STRATEGY_NAMES]
+        unknown = [s for s in suite.strategies if s not in STRATEGY_NAMES and s not in suite.weights]
         if unknown:
             raise SuiteError(f"{where}: unknown strategies {unknown}; choose from: {', '.join(STRATEGY_NAMES)}")
         for finding in suite.findings:
@@ -32,8 +32,10 @@ class EpisodesKind(SuiteKind):
 
     def run(self, suite: Suite, options: RunOptions) -> SuiteRun:
         started = time.perf_counter()
-        with RenderBar(f"{suite.task}/{suite.kitchen}", options.progress) as bar:  # once, before the workers
-            load_pools(suite.task, suite.kitchen, suite.datasets, suite.plan_options, progress=bar)
+        what = f"{suite.task}/{suite.kitchen}" + (f" (data seed {suite.data_seed})" if suite.data_seed else "")
+        with RenderBar(what, options.progress) as bar:  # once, before the workers
+            load_pools(suite.task, suite.kitchen, suite.datasets, suite.plan_options, progress=bar,
+                       data_seed=suite.data_seed)
         specs = episode_specs(suite, options.results)
         if options.ray:
             results = run_on_ray(specs, options.ray, options.progress)

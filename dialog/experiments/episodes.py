@@ -19,8 +19,9 @@ from dialog.settings import EpisodeSettings
 from dialog.teachers import make_teacher
 from dialog.threads import one_blas_thread
 from dialog.transcript import TranscriptWriter, read_transcript
+from dialog.user_weights import UserWeights
 from learning.errors import SettingsError
-from learning.strategies import make_strategy
+from learning.strategies import Strategy, make_strategy
 
 SERIES = ("turn", "accuracy", "questions", "label", "demo", "feature", "spent")
 
@@ -38,6 +39,8 @@ class EpisodeSpec:
     teacher: tuple  # ((option, value), ...)
     transcript: str
     plan: tuple = ()  # ((data-set plan option, value), ...), see dialog.experiments.pools.PLAN_OPTIONS
+    data_seed: int = 0  # the seed the pools were rendered from
+    weights: UserWeights | None = None  # a user's DT weights (regress --weights NAME=FILE); None: built-in strategy
 
     @property
     def episode_seed(self) -> int:
@@ -69,24 +72,29 @@ def suite_teacher(options: dict, rng: np.random.Generator):
     return make_teacher(kind, rng=rng, **{k: v for k, v in options.items() if k != "kind"})
 
 
-def run_episode(spec: EpisodeSpec) -> dict:
-    """Run one episode; returns its spec, per-turn series, final accuracy and wall time."""
+def run_episode(spec: EpisodeSpec, strategy: Strategy | None = None) -> dict:
+    """Run one episode; returns its spec, per-turn series, final accuracy and wall time.
+
+    ``strategy`` (default: the one ``spec`` names) is an already built strategy, e.g. IRL's MaxEnt policy,
+    which the caller can read after the episode (dialog.experiments.irl_rollouts)."""
     with one_blas_thread():
-        return _run_episode(spec)
+        return _run_episode(spec, strategy)
 
 
-def _run_episode(spec: EpisodeSpec) -> dict:
+def _run_episode(spec: EpisodeSpec, strategy: Strategy | None = None) -> dict:
     started = time.perf_counter()
-    pools = load_pools(spec.task, spec.kitchen, spec.dataset + 1, spec.plan)
+    pools = load_pools(spec.task, spec.kitchen, spec.dataset + 1, spec.plan, data_seed=spec.data_seed)
     condition = spec.condition
     scenes = -(-condition.turns // max(condition.change_every, 1))
     environment = PoolEnvironment(pools.train[spec.dataset], pools.test, pools.task, scenes)
     config = spec.settings().config()
     rngs = episode_generators(spec.episode_seed)
+    if strategy is None:
+        strategy = make_strategy(spec.strategy) if spec.weights is None else spec.weights.strategy(spec.strategy)
     Path(spec.transcript).parent.mkdir(parents=True, exist_ok=True)
     with TranscriptWriter(spec.transcript) as transcript:
         result = DialogManager(environment, suite_teacher(dict(spec.teacher), rngs["teacher"]),
-                               make_strategy(spec.strategy), config, transcript, rngs, say=lambda _: None).run()
+                               strategy, config, transcript, rngs, say=lambda _: None).run()
     series = series_from_transcript(read_transcript(spec.transcript))
     return {"spec": asdict(spec), "label": spec.label, "series": series, "accuracy": result.accuracy,
             "seconds": time.perf_counter() - started}

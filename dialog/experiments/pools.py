@@ -44,14 +44,17 @@ _loaded: dict[tuple, PoolSet] = {}
 
 
 def load_pools(task: str, kitchen: str, datasets: int, plan_options: tuple = (),
-               progress: RenderProgress | None = None) -> PoolSet:
+               progress: RenderProgress | None = None, data_seed: int = 0) -> PoolSet:
     """``datasets`` training pools and the test pool, from the cache (rendered once, then reused).
 
     ``plan_options`` ((name, value), ...) overrides the task's data-set plan (``pool_size``,
     ``test_size``, ``objects_per_scene``); accepted names are listed in the error otherwise.
-    ``progress`` hears of every pool rendered on a first run.
+    ``progress`` hears of every pool rendered on a first run. ``data_seed`` is the seed the pools are
+    rendered from (0: the data every report so far was made on); another seed gives fresh data sets.
     """
-    key = (task, kitchen, int(datasets), tuple(plan_options))
+    if isinstance(data_seed, bool) or not isinstance(data_seed, int | np.integer) or data_seed < 0:
+        raise SettingsError(f"data seed must be a whole number >= 0, got {data_seed!r}")
+    key = (task, kitchen, int(datasets), tuple(plan_options), int(data_seed))
     if key not in _loaded:
         while len(_loaded) >= KEPT_POOL_SETS:
             _loaded.pop(next(iter(_loaded)))
@@ -59,7 +62,7 @@ def load_pools(task: str, kitchen: str, datasets: int, plan_options: tuple = (),
     return _loaded[key]
 
 
-def _load_pools(task: str, kitchen: str, datasets: int, plan_options: tuple, progress) -> PoolSet:
+def _load_pools(task: str, kitchen: str, datasets: int, plan_options: tuple, data_seed: int, progress) -> PoolSet:
     from robot import Arm
 
     loaded = load_task(task)
@@ -76,7 +79,7 @@ def _load_pools(task: str, kitchen: str, datasets: int, plan_options: tuple, pro
             rendered.append(message)
             progress(len(rendered), total, message)
 
-    sets = load_datasets(task, kitchen, seed=0, plan=plan, robot_factory=Arm, progress=pool_rendered)
+    sets = load_datasets(task, kitchen, seed=data_seed, plan=plan, robot_factory=Arm, progress=pool_rendered)
     return PoolSet(sets.train[:datasets], sets.test, loaded)
 
 

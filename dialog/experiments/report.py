@@ -76,6 +76,10 @@ def markdown_report(suite: Suite, results: list[dict], summaries: list[Checkpoin
     lines = [f"# Regression report: {suite.name}", "", suite.description, "",
              f"- task `{suite.task}`, kitchen `{suite.kitchen}`, {suite.datasets} training data sets, "
              f"seeds {list(suite.seeds)}, teacher {suite.teacher or {'kind': 'scripted'}}",
+             f"- data sets rendered from data seed {suite.data_seed}"
+             + (" (the data of the stored baselines)" if suite.data_seed == 0 else " (fresh data: a replication)"),
+             *[f"- strategy `{name}`: DT with the weights in {weights.describe()}"
+               for name, weights in suite.weights.items()],
              f"- {len(results)} episodes in {seconds:.1f} s of wall time "
              f"({sum(r['seconds'] for r in results):.1f} s of episode time)",
              "- per-episode CSV: [episodes.csv](episodes.csv) (one row per episode, linking its per-turn CSV)", ""]

@@ -13,12 +13,14 @@ from pathlib import Path
 
 from dialog.experiments.episodes import EpisodeSpec, run_episode
 from dialog.experiments.suite import Suite
+from learning.actions import DEFAULT_COSTS
 from learning.errors import SetupError
 
 
 def episode_specs(suite: Suite, results_dir: Path) -> list[EpisodeSpec]:
     """Every (condition, strategy, data set, seed) of the suite, in a stable order."""
     specs = []
+    costs = tuple(sorted((suite.costs or DEFAULT_COSTS).items()))  # no [costs] table: the thesis's costs
     for condition in suite.conditions:
         for strategy in suite.strategies:
             for dataset in range(suite.datasets):
@@ -26,9 +28,9 @@ def episode_specs(suite: Suite, results_dir: Path) -> list[EpisodeSpec]:
                     transcript = results_dir / "transcripts" / condition.name / f"{strategy}-d{dataset}-s{seed}.jsonl"
                     specs.append(EpisodeSpec(
                         suite=suite.name, task=suite.task, kitchen=suite.kitchen, strategy=strategy,
-                        condition=condition, dataset=dataset, seed=seed, costs=tuple(sorted(suite.costs.items())),
+                        condition=condition, dataset=dataset, seed=seed, costs=costs,
                         teacher=tuple(sorted(suite.teacher.items())), transcript=str(transcript),
-                        plan=suite.plan_options))
+                        plan=suite.plan_options, data_seed=suite.data_seed, weights=suite.weights.get(strategy)))
     return specs
 
 
@@ -53,16 +55,7 @@ def run_locally(specs: list[EpisodeSpec], workers: int | None = None, progress: 
 
 def run_on_ray(specs: list[EpisodeSpec], address: str, progress: bool = True) -> list[dict]:
     """Run the same episodes as Ray tasks on the cluster at ``address`` ("local" starts one here)."""
-    try:
-        import ray
-    except ImportError:
-        raise SetupError("--ray needs the optional extra: pip install 'teachbot[ray]'") from None
-    if address == "local":
-        start_local_ray(ray)
-    else:
-        print(f"teachbot regress: --ray {address}: this code runs on that cluster and its results are unpickled "
-              "here; name only a cluster you trust", file=sys.stderr)
-        ray.init(address=address, ignore_reinit_error=True, log_to_driver=False)
+    ray = connect_ray(address)
     remote_episode = ray.remote(run_episode)
     pending = {remote_episode.remote(spec): i for i, spec in enumerate(specs)}
     results: list[dict | None] = [None] * len(specs)
@@ -73,6 +66,23 @@ def run_on_ray(specs: list[EpisodeSpec], address: str, progress: bool = True) ->
             results[index] = ray.get(done[0])
             advance(specs[index].label)
     return results
+
+
+def connect_ray(address: str, command: str = "regress"):
+    """The ``ray`` module, connected to the cluster at ``address`` ("local": a one-node instance started here).
+
+    Ray is optional: without it a one-line SetupError says how to install it."""
+    try:
+        import ray
+    except ImportError:
+        raise SetupError("--ray needs the optional extra: pip install 'teachbot[ray]'") from None
+    if address == "local":
+        start_local_ray(ray)
+    else:
+        print(f"teachbot {command}: --ray {address}: this code runs on that cluster and its results are unpickled "
+              "here; name only a cluster you trust", file=sys.stderr)
+        ray.init(address=address, ignore_reinit_error=True, log_to_driver=False)
+    return ray
 
 
 LOCAL_RAY_ENVIRONMENT = {

@@ -19,7 +19,7 @@ SUITE_DIR = Path(__file__).resolve().parents[1] / "suites"
 KINDS = ("episodes", "feature-selection", "recipes")
 AXES = ("questions", "turns", "demonstrations")
 SUITE_FIELDS = ("name", "description", "analysis", "kind", "task", "kitchen", "strategies", "datasets", "seeds",
-                "checkpoints", "axis", "costs", "teacher", "options", "dataset", "condition", "finding")
+                "checkpoints", "axis", "costs", "teacher", "options", "dataset", "data_seed", "condition", "finding")
 CONDITION_FIELDS = ("name", "budget", "turns", "change_every")
 FINDING_FIELDS = ("id", "text", "condition", "at", "better", "than", "alternative", "than_at", "margin")
 TEACHER_KINDS = ("scripted", "oracle")
@@ -76,15 +76,24 @@ class Suite:
     path: str = ""
     dataset: dict = field(default_factory=dict)  # overrides of the task's data-set plan ([dataset] table)
     analysis: str = ""  # where the written analysis of the findings lives (shown in the report)
+    data_seed: int = 0  # the seed the data sets are rendered from (0: the data of every stored baseline)
+    weights: dict = field(default_factory=dict)  # strategy name -> user's DT weights (regress --weights NAME=FILE)
 
     @property
     def plan_options(self) -> tuple:
         """The ``[dataset]`` table as a hashable ((name, value), ...) for ``pools.load_pools``."""
         return tuple(sorted(self.dataset.items()))
 
-    def with_overrides(self, strategies=None, seeds=None, budget=None, datasets=None) -> Suite:
+    def with_overrides(self, strategies=None, seeds=None, budget=None, datasets=None, data_seed=None) -> Suite:
         """The suite with command-line overrides applied."""
         suite = self
+        if data_seed is not None:
+            if isinstance(data_seed, bool) or not isinstance(data_seed, int) or data_seed < 0:
+                raise SuiteError(f"data seed must be a whole number >= 0, got {data_seed!r}")
+            if suite.kind == "recipes":
+                raise SuiteError(f"--data-seed: suite '{suite.name}' is of kind 'recipes', which renders no data "
+                                 "sets; it applies to episodes and feature-selection suites")
+            suite = replace(suite, data_seed=data_seed)
         if strategies:
             suite = replace(suite, strategies=tuple(strategies), findings=tuple(
                 f for f in suite.findings if f.better in strategies and set(f.than) <= set(strategies)))
@@ -95,6 +104,19 @@ class Suite:
         if datasets:
             suite = replace(suite, datasets=int(datasets))
         return suite
+
+    def with_weights(self, weights: dict) -> Suite:
+        """The suite with a DT strategy per ``{name: user weights}`` added after its own strategies."""
+        if not weights:
+            return self
+        if self.kind != "episodes":
+            raise SuiteError(f"--weights adds a DT strategy to an episodes suite; suite '{self.name}' is of kind "
+                             f"'{self.kind}'")
+        clash = [name for name in weights if name in self.strategies]
+        if clash:
+            raise SuiteError(f"--weights: the name '{clash[0]}' is already a strategy of suite '{self.name}' "
+                             f"({', '.join(self.strategies)}); choose another name")
+        return replace(self, strategies=(*self.strategies, *weights), weights={**self.weights, **weights})
 
 
 def suite_names() -> list[str]:
@@ -142,6 +164,8 @@ def _suite(table: dict, where: str, known_strategies) -> Suite:
     names = [c.name for c in conditions]
     if len(set(names)) != len(names):
         raise SuiteError(f"{where}: condition names must be unique, got {names}")
+    if kind == "recipes" and "data_seed" in table:
+        raise SuiteError(f"{where}: 'data_seed' is not accepted in a suite of kind 'recipes' (it renders no data sets)")
     findings = tuple(_finding(f, kind, strategies, names, f"{where} finding {i + 1}")
                      for i, f in enumerate(tables(table, "finding", where, [])))
     return Suite(
@@ -153,6 +177,7 @@ def _suite(table: dict, where: str, known_strategies) -> Suite:
         axis=text(table, "axis", where, "questions", choices=AXES), costs=_costs(table, where),
         teacher=_teacher(table, where), findings=findings, options=_options(table, kind, where), path=where,
         dataset=_plan(table, where), analysis=text(table, "analysis", where, "", nonempty=False),
+        data_seed=integer(table, "data_seed", where, 0, low=0),
     )
 
 

@@ -28,7 +28,8 @@ class FeatureSelectionKind(SuiteKind):
     def run(self, suite: Suite, options: RunOptions) -> SuiteRun:
         started = time.perf_counter()
         with RenderBar(f"{suite.task}/{suite.kitchen}", options.progress) as bar:
-            pools = load_pools(suite.task, suite.kitchen, 1, suite.plan_options, progress=bar)
+            pools = load_pools(suite.task, suite.kitchen, 1, suite.plan_options, progress=bar,
+                               data_seed=suite.data_seed)
         rows = run_feature_suite(suite, pools)
         summaries = feature_summaries(rows, suite)
         return SuiteRun(suite, rows, summaries, evaluate_findings(summaries, suite), len(rows),

@@ -68,7 +68,7 @@ def write_feature_report(suite: Suite, rows: list[dict], summaries: list[Checkpo
     figure, axes = plt.subplots(1, len(sizes), figsize=(6 * len(sizes), 4), squeeze=False)
     lines = [f"# Regression report: {suite.name}", "", suite.description, "",
              f"- task `{suite.task}`, {len(rows)} trained classifiers in {seconds:.1f} s; "
-             "raw rows: [runs.csv](runs.csv)",
+             "raw rows: [runs.csv](runs.csv)", f"- data sets rendered from data seed {suite.data_seed}",
              "", "![accuracy by approach](accuracy.png)", ""]
     for axis, n in zip(axes[0], sizes):
         group = [s for s in summaries if s.condition == f"n{n}"]
