@@ -1,0 +1,88 @@
+"""``teachbot study run|status|report STUDY.toml``: user studies with participants, conditions and questionnaires."""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+from pathlib import Path
+
+
+def register(subparsers) -> None:
+    parser = subparsers.add_parser("study", help="run a user study: participants, conditions, questionnaires, report",
+                                   description="Run a user study described by a study file (docs/studies.md).")
+    actions = parser.add_subparsers(dest="study_action", required=True, metavar="ACTION")
+
+    run = actions.add_parser(
+        "run", help="run one participant's sessions in their assigned order",
+        description="Run one participant's teaching sessions, one condition after another in the order the study "
+                    "assigns them, each followed by its questionnaire; --simulated lets a scripted teacher play "
+                    "the participant, to dry-run a study.")
+    _study_arguments(run)
+    run.add_argument("--participant", required=True, metavar="ID", help="the participant's id (never a name)")
+    run.add_argument("--simulated", action="store_true",
+                     help="a scripted teacher (the study's noise and delay models) plays the participant")
+    run.add_argument("--condition", default=None, metavar="NAME", help="run only this condition")
+    run.add_argument("--again", action="store_true",
+                     help="with --condition: run a condition already done again (the old records are kept, renamed)")
+    run.add_argument("--abort", default=None, metavar="REASON",
+                     help="mark the participant's current session aborted with REASON (it stays in the record)")
+    run.add_argument("--no-viewer", action="store_true", help="no meshcat viewer, whatever the conditions say")
+    run.set_defaults(handler=_run)
+
+    status = actions.add_parser(
+        "status", help="who has done what, what is missing or aborted, are orders balanced",
+        description="List every participant's sessions (done, running, questionnaire, aborted, missing) and say "
+                    "whether the orders of those who finished are balanced.")
+    _study_arguments(status)
+    status.set_defaults(handler=_status)
+
+    report = actions.add_parser(
+        "report", help="tidy CSV tables, a Markdown report with tests, and PNG plots",
+        description="Write the study's recorded turns and questionnaire answers as tidy CSV tables, a Markdown "
+                    "report with significance tests between conditions, and PNG plots.")
+    _study_arguments(report)
+    report.add_argument("--out", type=Path, default=None, metavar="DIR",
+                        help="where the report goes (default: <study folder>/report)")
+    report.set_defaults(handler=_report)
+
+
+def _study_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("study", type=Path, metavar="STUDY.toml", help="the study file")
+    parser.add_argument("--folder", type=Path, default=None, metavar="DIR",
+                        help="the study's records folder (default: the study file's 'folder')")
+
+
+def _load(args):
+    from dialog.study.studyfile import load_study
+
+    study = load_study(args.study)
+    if args.folder is not None:
+        study = dataclasses.replace(study, folder=args.folder)
+    return study
+
+
+def _run(args) -> int:
+    from dialog.study.run import ParticipantRun
+
+    study = _load(args)
+    runner = ParticipantRun(study, args.participant, args.simulated, viewer=False if args.no_viewer else None)
+    if args.abort is not None:
+        return runner.abort(args.abort)
+    return runner.run(args.condition, args.again)
+
+
+def _status(args) -> int:
+    from dialog.study.status import status_text
+
+    print(status_text(_load(args)), flush=True)
+    return 0
+
+
+def _report(args) -> int:
+    from dialog.study.report import write_report
+
+    study = _load(args)
+    written = write_report(study, args.out or study.folder / "report")
+    for path in written:
+        print(path)
+    return 0

@@ -1,0 +1,88 @@
+"""The questionnaire after a session: asked at the terminal (or answered by a simulated participant), then saved.
+
+A Likert item takes a whole number from 1 to its number of points (``skip``
+leaves it unanswered); a free-text item takes any line (empty: unanswered).
+The answers are written together, once all are given, as JSON Lines: a
+``questionnaire`` header (who, which condition, which position, which software)
+and one line per item.
+"""
+
+from __future__ import annotations
+
+import json
+
+from dialog.study.files import write_atomically
+
+SKIP_WORDS = ("skip", "pass", "-")
+
+
+def likert_value(line: str, points: int) -> tuple[bool, int | None]:
+    """(accepted, value) for one typed line: a number 1..points, or a skip word (value None)."""
+    text = line.strip().lower()
+    if text in SKIP_WORDS:
+        return True, None
+    if text.isdigit() and 1 <= int(text) <= points:
+        return True, int(text)
+    return False, None
+
+
+def ask_terminal(items, read_line, write) -> list[dict] | None:
+    """Each item's answer from a person; None when the input ended before the last one (nothing is saved)."""
+    answers = []
+    write(f"\nA few questions about this session ({len(items)}). Type 'skip' to leave one out.")
+    for number, item in enumerate(items, start=1):
+        if item.kind == "likert":
+            write(f"\n{number}. {item.text}\n   1 = {item.anchors[0]} ... {item.points} = {item.anchors[1]}")
+            while True:
+                write("> ", end="")
+                line = read_line()
+                if line is None:
+                    return None
+                accepted, value = likert_value(line, item.points)
+                if accepted:
+                    break
+                write(f"   Please type a whole number from 1 to {item.points}, or 'skip'.")
+        else:
+            write(f"\n{number}. {item.text}\n   (any text; Enter alone leaves it out)")
+            write("> ", end="")
+            line = read_line()
+            if line is None:
+                return None
+            value = line.strip()[:2000] or None
+        answers.append({"item": item.id, "kind": item.kind, "value": value})
+    return answers
+
+
+def ask_simulated(items, rng) -> list[dict]:
+    """A simulated participant's answers: Likert values around the middle of the scale, a fixed free text."""
+    answers = []
+    for item in items:
+        if item.kind == "likert":
+            middle = (item.points + 1) / 2
+            value = int(min(item.points, max(1, round(rng.normal(middle, item.points / 5)))))
+        else:
+            value = "(simulated participant)"
+        answers.append({"item": item.id, "kind": item.kind, "value": value})
+    return answers
+
+
+def save(path, header: dict, answers: list[dict]) -> None:
+    lines = [json.dumps({"questionnaire": header}, ensure_ascii=False)]
+    lines += [json.dumps(answer, ensure_ascii=False) for answer in answers]
+    write_atomically(path, "\n".join(lines) + "\n", "questionnaire answers")
+
+
+def load(path) -> tuple[dict, list[dict]]:
+    """The header and the answers of a saved questionnaire."""
+    from learning.errors import TranscriptError
+
+    rows = []
+    with open(path, encoding="utf-8") as handle:
+        for number, line in enumerate(handle, start=1):
+            try:
+                rows.append(json.loads(line))
+            except json.JSONDecodeError as error:
+                raise TranscriptError(f"{path}: line {number} is not a JSON record ({error.msg})") from None
+    if not rows or not isinstance(rows[0], dict) or "questionnaire" not in rows[0]:
+        raise TranscriptError(f"{path}: line 1 is not a questionnaire header")
+    return rows[0]["questionnaire"], rows[1:]

@@ -1,0 +1,237 @@
+"""``teachbot study run``: one participant's sessions, in their assigned order, each followed by the questionnaire.
+
+For each condition not yet done: the instruction screen, the teach session
+(the same loop as ``teachbot teach``, resumed from its transcript when it was
+interrupted), the questionnaire, and a pause before the next. A person answers
+at the terminal; ``simulated`` lets the scripted teacher (with the study's
+noise and delay options) play the participant.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from dataclasses import dataclass, field
+
+from dialog.environment import SimulatedKitchen
+from dialog.output_paths import check_writable
+from dialog.session import SessionSettings, open_session
+from dialog.study import questionnaire
+from dialog.study.design import assigned_orders, questionnaire_rng, session_seed
+from dialog.study.files import (
+    read_transcript_checked,
+    session_files,
+    session_state,
+    study_header,
+    supersede,
+    write_atomically,
+)
+from dialog.terminal import LineReader
+from dialog.transcript_lock import TranscriptLock
+from learning.errors import OutputPathError, TranscriptError
+
+
+@dataclass(frozen=True)
+class StudySessionSettings(SessionSettings):
+    """A teach session's settings plus the study table every header of the study carries."""
+
+    study: dict = field(default_factory=dict)
+
+    def header(self) -> dict:
+        return {**super().header(), "study": dict(self.study)}
+
+
+def condition_settings(study, participant: str, order: int, condition, simulated: bool) -> StudySessionSettings:
+    teacher = {"kind": "scripted", **study.simulated_teacher} if simulated else {"kind": "terminal"}
+    return StudySessionSettings(
+        task=condition.task, kitchen=condition.kitchen, strategy=condition.strategy,
+        seed=session_seed(study, participant, condition.name), turns=condition.turns, budget=condition.budget,
+        change_every=condition.change_every, realtime=condition.realtime, fetch_from_pantry=condition.fetch_from_pantry,
+        costs=dict(condition.costs), teacher=teacher,
+        study=study_header(study, participant, condition.name, order))
+
+
+class ParticipantRun:
+    """The terminal side of one participant's run: what they read, what they type, and the files it writes."""
+
+    def __init__(self, study, participant: str, simulated: bool, input_stream=None, output_stream=None,
+                 viewer: bool | None = None):
+        self.study, self.participant, self.simulated = study, study.check_participant(participant), simulated
+        self.order = assigned_orders(study)[participant]
+        self.input_stream = input_stream if input_stream is not None else sys.stdin
+        self.out = output_stream if output_stream is not None else sys.stdout
+        self.reader = LineReader(self.input_stream)
+        self.viewer = viewer
+
+    def write(self, text: str, end: str = "\n") -> None:
+        print(text, end=end, file=self.out, flush=True)
+
+    def read_line(self):
+        return self.reader.readline()
+
+    def states(self) -> list:
+        asks = bool(self.study.items)
+        return [session_state(session_files(self.study, self.participant, position, name),
+                              self.study.condition(name).turns,
+                              study_header(self.study, self.participant, name, position), asks)
+                for position, name in enumerate(self.order, start=1)]
+
+    # -- what to run --------------------------------------------------------------------------------------
+    def plan(self, only: str | None, again: bool) -> list[int]:
+        """The positions to run now; refuses a participant or a condition already done, unless ``again``."""
+        states = self.states()
+        if only is not None:
+            self.study.condition(only)
+            position = self.order.index(only) + 1
+            state = states[position - 1]
+            if state.state in ("done", "aborted") and not again:
+                raise TranscriptError(f"{self.participant} already did condition '{only}' ({state.state}); "
+                                      f"run it again only with --again (the old records are kept, renamed)")
+            if again and state.state != "missing":
+                files = session_files(self.study, self.participant, position, only)
+                lock = TranscriptLock(files.transcript, create=False) if files.transcript.exists() else None
+                try:  # not while another process still writes the session
+                    moved = supersede(files)
+                finally:
+                    if lock is not None:
+                        lock.release()
+                self.write(f"Kept the earlier records as {', '.join(p.name for p in moved)}.")
+            return [position]
+        if again:
+            raise TranscriptError("--again needs --condition NAME: the one condition to run again")
+        todo = [position for position, state in enumerate(states, start=1) if state.state not in ("done", "aborted")]
+        if not todo:
+            raise TranscriptError(f"{self.participant} has already done every session of study '{self.study.name}' "
+                                  f"(see teachbot study status); to run one again: --condition NAME --again")
+        return todo
+
+    def abort(self, reason: str) -> int:
+        """Mark the participant's current session (the first not done) aborted, with the reason; it stays recorded."""
+        if not reason.strip():
+            raise TranscriptError("--abort needs a reason, e.g. --abort \"participant felt unwell\"")
+        for position, state in enumerate(self.states(), start=1):
+            if state.state in ("done", "aborted"):
+                continue
+            name = self.order[position - 1]
+            files = session_files(self.study, self.participant, position, name)
+            note = {**study_header(self.study, self.participant, name, position), "reason": reason.strip(),
+                    "after_turns": state.turns_done, "state_before": state.state}
+            check_writable(files.aborted, "abort note")
+            write_atomically(files.aborted, json.dumps({"aborted": note}, ensure_ascii=False) + "\n", "abort note")
+            self.write(f"{self.participant}: session {position} ({name}) marked aborted after {state.turns_done} "
+                       f"turns: {reason.strip()}")
+            return 0
+        raise TranscriptError(f"{self.participant} has no unfinished session to abort")
+
+    # -- running ------------------------------------------------------------------------------------------
+    def run(self, only: str | None = None, again: bool = False) -> int:
+        positions = self.plan(only, again)
+        check_writable(self.study.folder / self.participant, "participant's folder", folder=True)
+        self.write(f"Study '{self.study.name}', participant {self.participant}: {len(self.order)} sessions in the "
+                   f"order {', '.join(self.order)}; {len(positions)} to run now.")
+        for count, position in enumerate(positions):
+            if count and not self.simulated:
+                self.write(f"\n{self.study.pause}")
+                self.read_line()
+            stopped = self.run_one(position)
+            if stopped is not None:
+                return stopped
+        self.write(f"{self.participant}: all sessions done for now. Thank you!")
+        return 0
+
+    def run_one(self, position: int) -> int | None:
+        """One session and its questionnaire; None when both are done, else the exit code to stop the run with."""
+        name = self.order[position - 1]
+        condition = self.study.condition(name)
+        files = session_files(self.study, self.participant, position, name)
+        settings = condition_settings(self.study, self.participant, position, condition, self.simulated)
+        state = session_state(files, condition.turns, settings.study, bool(self.study.items))
+        self.write(f"\n=== Session {position} of {len(self.order)} ({name}) ===")
+        if state.state in ("missing", "running"):
+            self.write(condition.instructions.strip())
+            if state.state == "running":
+                self.write(f"(This session was interrupted after {state.turns_done} turns; it goes on from there.)")
+            if not self.simulated:
+                self.write("Press Enter to begin.")
+                self.read_line()
+            finished = self.teach(files, settings, condition, resume=state.state == "running")
+            if not finished:
+                self.write(f"Session saved. Continue with: teachbot study run {self.study.path} --participant "
+                           f"{self.participant}" + (" --simulated" if self.simulated else ""))
+                return 130 if finished is None else 0
+        if self.study.items:
+            header = settings.study
+            if self.simulated:
+                answers = questionnaire.ask_simulated(self.study.items, questionnaire_rng(self.study, self.participant,
+                                                                                          name))
+            else:
+                answers = questionnaire.ask_terminal(self.study.items, self.read_line, self.write)
+                if answers is None:
+                    self.write("The questionnaire was not finished; it is asked again when the run goes on.")
+                    return 0
+            questionnaire.save(files.questionnaire, header, answers)
+            self.write(f"Answers saved ({files.questionnaire.name}).")
+        return None
+
+    def teach(self, files, settings: StudySessionSettings, condition, resume: bool) -> bool | None:
+        """Run (or resume) one teach session; True when all its turns are done, False if quit, None if interrupted."""
+        lock = TranscriptLock(files.transcript, create=not resume)
+        try:
+            if resume:
+                read_transcript_checked(files, settings.study)
+            elif lock.size() > 0:
+                raise TranscriptError(f"{files.transcript} already holds a session")
+            return self._teach(files, settings, condition, resume, lock)
+        finally:
+            lock.release()
+
+    def _teach(self, files, settings, condition, resume: bool, lock) -> bool | None:
+        person = not self.simulated
+        pictures = None
+        if person:
+            try:
+                pictures = check_writable(files.pictures, "scene pictures", folder=True)
+            except OutputPathError as error:
+                self.write(f"warning: {error}; going on without scene pictures")
+        environment = SimulatedKitchen(task=settings.task, kitchen=settings.kitchen, seed=settings.seed,
+                                       pictures=pictures is not None)
+        viewer = None
+        try:
+            from dialog.commands._viewer import start_viewer, stop_viewer
+
+            want_viewer = condition.viewer if self.viewer is None else self.viewer
+            if want_viewer and person:
+                viewer = start_viewer(argparse.Namespace(viewer=True, viewer_export=None), environment.world)
+            manager, records = open_session(settings, environment, files.transcript, resume=resume,
+                                            pictures=None if pictures is None else str(pictures),
+                                            input_stream=self.input_stream, output_stream=self.out,
+                                            observers=() if viewer is None else (viewer,), lock=lock)
+            if person:
+                manager.teacher.reader = self.reader  # one reader for the whole run: nothing typed is lost
+                self.write("Type 'help' at any question for what you can answer; 'why' asks the robot's reason, "
+                           "'undo' takes back your last answer, 'quit' saves and stops.")
+            manager.say = self._narrator(manager.teacher, person)
+            try:
+                result = manager.run(replay=records)
+            except KeyboardInterrupt:
+                self.write("\nInterrupted; the session is saved.")
+                return None
+            finally:
+                manager.transcript.close()
+            self.write(f"Session over: held-out accuracy {result.accuracy:.1%}, {result.completed} of {result.turns} "
+                       f"turns, budget spent {result.budget_spent:g} of {settings.budget:g}.")
+            return result.completed >= result.turns
+        finally:
+            if viewer is not None:
+                stop_viewer(viewer)
+            environment.close()
+
+    def _narrator(self, teacher, person: bool):
+        def say(text: str) -> None:
+            if not person:
+                return  # a simulated run prints one line per session
+            if text.startswith("Turn") and "stays quiet" not in text and "ended the session" not in text:
+                return
+            teacher.say(text)
+        return say

@@ -1,0 +1,83 @@
+"""``teachbot study status``: who has done what, what is missing or aborted, and whether the orders are balanced."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from dialog.study.design import assigned_orders, balance, williams_rows
+from dialog.study.files import SessionState, session_files, session_state, study_header
+
+
+@dataclass(frozen=True)
+class Cell:
+    participant: str
+    position: int
+    condition: str
+    state: SessionState
+
+
+def study_cells(study) -> list[Cell]:
+    """One cell per participant and session position, with the state read from the files."""
+    cells = []
+    asks = bool(study.items)
+    for participant, order in assigned_orders(study).items():
+        for position, name in enumerate(order, start=1):
+            files = session_files(study, participant, position, name)
+            state = session_state(files, study.condition(name).turns, study_header(study, participant, name, position),
+                                  asks)
+            cells.append(Cell(participant, position, name, state))
+    return cells
+
+
+def _shown(state: SessionState, turns: int) -> str:
+    if state.state == "running":
+        return f"running {state.turns_done}/{turns}"
+    if state.state == "aborted":
+        return "ABORTED"
+    if state.state == "questionnaire":
+        return "questionnaire due"
+    return state.state
+
+
+def completed_orders(study, cells: list[Cell]) -> list[tuple[str, ...]]:
+    """The orders of the participants who finished every session (aborted ones count as not finished)."""
+    orders = assigned_orders(study)
+    done = {}
+    for cell in cells:
+        done.setdefault(cell.participant, []).append(cell.state.state == "done")
+    return [orders[participant] for participant, flags in done.items() if all(flags)]
+
+
+def status_text(study) -> str:
+    cells = study_cells(study)
+    names = [c.name for c in study.conditions]
+    width = max(12, *(len(n) + 2 for n in names))
+    lines = [f"Study '{study.name}' ({study.path}), records in {study.folder}",
+             "participant  " + "".join(f"{f'{p}. ':>4}{'':<{width - 4}}" for p in range(1, len(names) + 1))]
+    by_participant: dict[str, list[Cell]] = {}
+    for cell in cells:
+        by_participant.setdefault(cell.participant, []).append(cell)
+    for participant, row in by_participant.items():
+        shown = "".join(f"{cell.condition + ':':<{width}}"[:width] for cell in row)
+        lines.append(f"{participant:<13}{shown}")
+        lines.append(f"{'':<13}" + "".join(f"{_shown(c.state, study.condition(c.condition).turns):<{width}}"
+                                            for c in row))
+    counts = {state: sum(c.state.state == state for c in cells) for state in
+              ("done", "running", "questionnaire", "aborted", "missing")}
+    lines.append("sessions: " + ", ".join(f"{count} {state}" for state, count in counts.items()))
+    for cell in cells:
+        if cell.state.state == "aborted":
+            lines.append(f"aborted: {cell.participant} session {cell.position} ({cell.condition}) after "
+                         f"{cell.state.turns_done} turns: {cell.state.reason or 'no reason given'}")
+    finished = completed_orders(study, cells)
+    result = balance(finished, names)
+    block = len(williams_rows(len(names))) if study.ordering == "latin" else None
+    verdict = "balanced" if result.balanced else (
+        "positions balanced, carry-over not" if result.positions_balanced else "NOT balanced")
+    note = f" (a complete block is a multiple of {block} participants)" if block else ""
+    lines.append(f"orders of the {len(finished)} participants who finished every session: {verdict}{note}")
+    if not result.positions_balanced:
+        for name in names:
+            counts = [result.positions[(name, p)] for p in range(1, len(names) + 1)]
+            lines.append(f"  {name}: at positions 1..{len(names)} {counts} times")
+    return "\n".join(lines)

@@ -1,0 +1,198 @@
+"""The study file (TOML): conditions, participants, their orders, seeds, questionnaire; loaded and validated.
+
+Every field goes through ``learning.datafiles``, so a bad study file is refused
+with one line naming the file, the section, the field and what is accepted.
+Participants are known by short ids only (never names): ``P01``, ``lab2-07``.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from bullet_world.datafiles import available
+from dialog.settings import DEFAULTS
+from dialog.teachers import SCRIPTED_OPTIONS
+from learning import datafiles as df
+from learning.actions import DEFAULT_COSTS
+from learning.errors import DataFileError
+from learning.strategies import STRATEGY_NAMES
+
+ID_PATTERN = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_-]{0,15}$")
+ID_RULE = "1 to 16 letters, digits, '-' or '_', starting with a letter or digit (an id, never a name)"
+NAME_PATTERN = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_-]{0,39}$")
+ORDERINGS = ("latin", "given")
+ITEM_KINDS = ("likert", "text")
+CONDITION_FIELDS = ("name", "instructions", "task", "kitchen", "strategy", "budget", "turns", "change_every",
+                    "realtime", "costs", "viewer", "fetch_from_pantry")
+
+
+def check_participant_id(value, where: str = "participant") -> str:
+    """A participant id: short, no spaces or path separators; else a DataFileError saying what is accepted."""
+    if not isinstance(value, str) or not ID_PATTERN.match(value):
+        raise DataFileError(f"{where}: participant id {value!r} is not accepted; an id is {ID_RULE}")
+    return value
+
+
+@dataclass(frozen=True)
+class Condition:
+    """One condition of the study: the settings of its teach session and the instructions shown before it."""
+
+    name: str
+    instructions: str
+    task: str
+    kitchen: str
+    strategy: str
+    budget: float
+    turns: int
+    change_every: int
+    realtime: float | None = None
+    costs: dict = field(default_factory=lambda: dict(DEFAULT_COSTS))
+    viewer: bool = False
+    fetch_from_pantry: bool = True
+
+
+@dataclass(frozen=True)
+class Item:
+    """A questionnaire item: a Likert scale of ``points`` with its two anchors, or free text."""
+
+    id: str
+    kind: str
+    text: str
+    points: int = 0
+    anchors: tuple[str, str] = ("", "")
+
+
+@dataclass(frozen=True)
+class Study:
+    path: Path
+    name: str
+    seed: int
+    folder: Path
+    conditions: tuple[Condition, ...]
+    participants: tuple[str, ...]
+    ordering: str
+    given_orders: dict
+    items: tuple[Item, ...]
+    simulated_teacher: dict
+    pause: str
+
+    def condition(self, name: str) -> Condition:
+        for condition in self.conditions:
+            if condition.name == name:
+                return condition
+        raise DataFileError(f"{self.path}: no condition '{name}'; the conditions are "
+                            f"{', '.join(c.name for c in self.conditions)}")
+
+    def check_participant(self, participant: str) -> str:
+        check_participant_id(participant)
+        if participant not in self.participants:
+            shown = ", ".join(self.participants[:6]) + (" ..." if len(self.participants) > 6 else "")
+            raise DataFileError(f"{self.path}: participant '{participant}' is not in the study; its ids are {shown}")
+        return participant
+
+
+def load_study(path: str | Path) -> Study:
+    """The study in ``path``, validated; its folder defaults to ``runs/studies/<name>`` (relative to the cwd)."""
+    path = Path(path)
+    data = df.read_toml(path, "study")
+    where = str(path)
+    df.check_keys(data, where, required=("name", "seed", "conditions"),
+                  optional=("folder", "participants", "ids", "order", "orders", "pause", "simulated_teacher",
+                            "questionnaire"))
+    name = df.text(data, "name", where)
+    if not NAME_PATTERN.match(name):
+        raise DataFileError(f"{where}: name {name!r} must be 1 to 40 letters, digits, '-' or '_' (it names the folder)")
+    seed = df.integer(data, "seed", where, low=0)
+    conditions = tuple(_condition(table, f"{where} [[conditions]] {index + 1}")
+                       for index, table in enumerate(df.tables(data, "conditions", where, nonempty=True)))
+    names = [c.name for c in conditions]
+    if len(set(names)) != len(names):
+        raise DataFileError(f"{where}: condition names must differ, got {names}")
+    if len(conditions) > 8:
+        raise DataFileError(f"{where}: at most 8 conditions, got {len(conditions)}")
+    participants = _participants(data, where)
+    ordering = df.text(data, "order", where, default="latin", choices=ORDERINGS)
+    given = _given_orders(data, where, ordering, participants, names)
+    items = tuple(_item(table, f"{where} [[questionnaire]] {index + 1}")
+                  for index, table in enumerate(df.tables(data, "questionnaire", where, default=[])))
+    if len({item.id for item in items}) != len(items):
+        raise DataFileError(f"{where}: questionnaire item ids must differ")
+    teacher = df.section(data, "simulated_teacher", where, default={})
+    df.check_keys(teacher, f"{where} [simulated_teacher]", optional=SCRIPTED_OPTIONS)
+    simulated = {key: df.number(teacher, key, f"{where} [simulated_teacher]", low=0,
+                                high=None if key == "answer_delay" else 1) for key in teacher}
+    folder = Path(df.text(data, "folder", where, default=f"runs/studies/{name}"))
+    pause = df.text(data, "pause", where, default="Take a short break. Press Enter when you are ready to go on.")
+    return Study(path, name, seed, folder, conditions, participants, ordering, given, items, simulated, pause)
+
+
+def _condition(table: dict, where: str) -> Condition:
+    df.check_keys(table, where, required=("name", "strategy"), optional=CONDITION_FIELDS)
+    name = df.text(table, "name", where)
+    if not ID_PATTERN.match(name):
+        raise DataFileError(f"{where}: condition name {name!r} must be {ID_RULE.split(' (')[0]} (it names files)")
+    costs = df.section(table, "costs", where, default=dict(DEFAULT_COSTS))
+    df.check_keys(costs, f"{where} costs", required=tuple(DEFAULT_COSTS))
+    realtime = df.number(table, "realtime", where, default=None, above=0)
+    return Condition(
+        name=name,
+        instructions=df.text(table, "instructions", where, default="Teach the robot the words of the task."),
+        task=df.text(table, "task", where, default=DEFAULTS.task, choices=available("tasks")),
+        kitchen=df.text(table, "kitchen", where, default=DEFAULTS.kitchen, choices=available("kitchens")),
+        strategy=df.text(table, "strategy", where, choices=STRATEGY_NAMES),
+        budget=df.number(table, "budget", where, default=DEFAULTS.budget, low=0),
+        turns=df.integer(table, "turns", where, default=DEFAULTS.turns, low=1, high=500),
+        change_every=df.integer(table, "change_every", where, default=DEFAULTS.change_every, low=1),
+        realtime=realtime,
+        costs={key: df.number(costs, key, f"{where} costs", low=0) for key in DEFAULT_COSTS},
+        viewer=df.flag(table, "viewer", where, default=False),
+        fetch_from_pantry=df.flag(table, "fetch_from_pantry", where, default=True),
+    )
+
+
+def _participants(data: dict, where: str) -> tuple[str, ...]:
+    if ("participants" in data) == ("ids" in data):
+        raise DataFileError(f"{where}: give either 'participants' (how many: ids P01, P02, ...) or 'ids' "
+                            "(a list of participant ids), not both or neither")
+    if "participants" in data:
+        count = df.integer(data, "participants", where, low=1, high=999)
+        return tuple(f"P{number:02d}" for number in range(1, count + 1))
+    ids = df.texts(data, "ids", where, nonempty=True)
+    for value in ids:
+        check_participant_id(value, f"{where}: ids")
+    if len(set(ids)) != len(ids):
+        raise DataFileError(f"{where}: 'ids' lists a participant twice")
+    return ids
+
+
+def _given_orders(data: dict, where: str, ordering: str, participants, names) -> dict:
+    if ordering == "latin":
+        if "orders" in data:
+            raise DataFileError(f"{where}: [orders] is only read with order = \"given\"")
+        return {}
+    orders = df.section(data, "orders", where)
+    df.check_keys(orders, f"{where} [orders]", required=participants)
+    result = {}
+    for participant in participants:
+        given = df.texts(orders, participant, f"{where} [orders]", choices=names)
+        if sorted(given) != sorted(names):
+            raise DataFileError(f"{where} [orders]: {participant} must run every condition once, in some order; "
+                                f"got {list(given)} for {names}")
+        result[participant] = tuple(given)
+    return result
+
+
+def _item(table: dict, where: str) -> Item:
+    kind = df.text(table, "kind", where, choices=ITEM_KINDS)
+    if kind == "text":
+        df.check_keys(table, where, required=("id", "kind", "text"))
+        return Item(df.text(table, "id", where), kind, df.text(table, "text", where))
+    df.check_keys(table, where, required=("id", "kind", "text", "anchors"), optional=("points",))
+    anchors = df.texts(table, "anchors", where, nonempty=True)
+    if len(anchors) != 2:
+        raise DataFileError(f"{where}: 'anchors' must name the two ends of the scale, e.g. [\"disagree\", "
+                            f"\"agree\"], got {list(anchors)}")
+    return Item(df.text(table, "id", where), kind, df.text(table, "text", where),
+                df.integer(table, "points", where, default=7, low=2, high=11), (anchors[0], anchors[1]))

@@ -1,0 +1,67 @@
+"""The study's records as tidy tables: one row per recorded turn, one per questionnaire answer.
+
+Every session that has a transcript contributes its turns, finished or not
+(``state`` says which); the analysis uses the finished ones.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from dialog.study import questionnaire
+from dialog.study.files import read_transcript_checked, session_files, study_header
+from dialog.study.status import Cell, study_cells
+
+TURN_COLUMNS = ("participant", "condition", "order", "state", "turn", "action", "cost", "answer", "answer_seconds",
+                "refused", "accuracy")
+ANSWER_COLUMNS = ("participant", "condition", "order", "item", "kind", "value")
+COMMAND_WORDS = frozenset({"help", "?", "why", "more", "undo"})  # lines that ask something rather than answer
+
+
+def refused_attempts(answer: dict) -> int:
+    """Lines typed before the one taken that were answers the robot could not take (help, why, undo not counted)."""
+    lines = list(answer.get("lines") or [])
+    taken = 1 if answer.get("kind") in ("answer", "absent", "skip", "dont_know") and lines else 0
+    return sum(line.strip().lower() not in COMMAND_WORDS for line in lines[:len(lines) - taken])
+
+
+@dataclass
+class StudyTables:
+    cells: list[Cell]
+    turns: list[dict]
+    answers: list[dict]
+
+
+def collect(study) -> StudyTables:
+    cells = study_cells(study)
+    turns, answers = [], []
+    for cell in cells:
+        files = session_files(study, cell.participant, cell.position, cell.condition)
+        key = {"participant": cell.participant, "condition": cell.condition, "order": cell.position}
+        if files.transcript.exists() and files.transcript.stat().st_size > 0:
+            _, records = read_transcript_checked(files, study_header(study, cell.participant, cell.condition,
+                                                                     cell.position))
+            for record in records:
+                answer = record.get("answer") or {}
+                turns.append({**key, "state": cell.state.state, "turn": record["turn"],
+                              "action": record["action"]["kind"], "cost": record.get("cost", 0.0),
+                              "answer": answer.get("kind", "none"), "answer_seconds": answer.get("seconds", 0.0),
+                              "refused": refused_attempts(answer), "accuracy": record.get("accuracy")})
+        if files.questionnaire.exists():
+            for row in questionnaire.load(files.questionnaire)[1]:
+                answers.append({**key, "item": row["item"], "kind": row["kind"], "value": row["value"]})
+    return StudyTables(cells, turns, answers)
+
+
+def write_csv(path, columns, rows) -> None:
+    import csv
+    import io
+
+    from dialog.study.files import write_atomically
+
+    buffer = io.StringIO()
+    writer = csv.DictWriter(buffer, fieldnames=list(columns), lineterminator="\n")
+    writer.writeheader()
+    for row in rows:
+        writer.writerow({column: "" if row.get(column) is None else row.get(column) for column in columns})
+    write_atomically(path, buffer.getvalue(), "study table")

@@ -1,0 +1,147 @@
+"""The shipped example study, dry-run with --simulated for a few participants: run, status, report."""
+
+import csv
+import dataclasses
+import json
+import shutil
+from pathlib import Path
+
+import pytest
+
+from dialog.cli import main
+from dialog.study.design import assigned_orders
+from dialog.study.files import session_files
+from dialog.study.studyfile import load_study
+from dialog.study.tables import refused_attempts
+from dialog.transcript import read_session
+
+EXAMPLE = Path(__file__).resolve().parents[3] / "dialog" / "data" / "studies" / "example.toml"
+PARTICIPANTS = ("P01", "P02", "P03")
+
+
+def study_cli(folder, *args):
+    return main(["study", args[0], str(EXAMPLE), "--folder", str(folder), *args[1:]])
+
+
+@pytest.fixture(scope="module")
+def folder(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("study") / "records"
+    for participant in PARTICIPANTS:
+        assert study_cli(folder, "run", "--participant", participant, "--simulated") == 0
+    return folder
+
+
+def test_every_session_is_recorded_with_the_study_header(folder):
+    study = dataclasses.replace(load_study(EXAMPLE), folder=folder)
+    for participant in PARTICIPANTS:
+        for position, name in enumerate(assigned_orders(study)[participant], start=1):
+            files = session_files(study, participant, position, name)
+            header, records = read_session(files.transcript)
+            assert header["study"] == {"study": "example", "participant": participant, "condition": name,
+                                       "order": position, "software": "teachbot 0.1.0"}
+            assert header["strategy"] == study.condition(name).strategy
+            assert len(records) == study.condition(name).turns
+            lines = files.questionnaire.read_text().splitlines()
+            assert json.loads(lines[0])["questionnaire"] == header["study"]
+            assert [json.loads(line)["item"] for line in lines[1:]] == ["ease", "smart", "comments"]
+
+
+def test_a_participant_who_is_done_is_refused_unless_asked(folder, capsys):
+    assert study_cli(folder, "run", "--participant", "P01", "--simulated") == 2
+    assert "already done every session" in capsys.readouterr().err
+    assert study_cli(folder, "run", "--participant", "P01", "--simulated", "--condition", "active") == 2
+    assert "--again" in capsys.readouterr().err
+    assert study_cli(folder, "run", "--participant", "Jane Doe", "--simulated") == 2
+    assert "not accepted" in capsys.readouterr().err
+    assert study_cli(folder, "run", "--participant", "P99", "--simulated") == 2
+    assert "not in the study" in capsys.readouterr().err
+
+
+def test_an_interrupted_participant_resumes_where_they_stopped(folder, tmp_path):
+    copy = tmp_path / "records"
+    shutil.copytree(folder, copy)
+    person = copy / "P02"
+    order = assigned_orders(load_study(EXAMPLE))["P02"]
+    second = person / f"2-{order[1]}.jsonl"
+    complete = second.read_text()
+    lines = complete.splitlines(keepends=True)
+    second.write_text("".join(lines[:4]) + lines[4][:30])  # three turns, then a crash mid-line
+    (person / f"2-{order[1]}-questionnaire.jsonl").unlink()
+    for path in person.glob(f"3-{order[2]}*"):
+        path.unlink()
+    assert study_cli(copy, "run", "--participant", "P02", "--simulated") == 0
+    assert second.read_text() == complete  # the resumed session repeats the interrupted one exactly
+    assert (person / f"3-{order[2]}.jsonl").read_text() == (folder / "P02" / f"3-{order[2]}.jsonl").read_text()
+    assert (person / f"1-{order[0]}.jsonl").stat().st_mtime == (folder / "P02" / f"1-{order[0]}.jsonl").stat().st_mtime
+
+
+def test_a_condition_run_again_keeps_the_old_records(folder, tmp_path):
+    copy = tmp_path / "records"
+    shutil.copytree(folder, copy)
+    first = assigned_orders(load_study(EXAMPLE))["P03"][0]
+    assert study_cli(copy, "run", "--participant", "P03", "--simulated", "--condition", first, "--again") == 0
+    again = copy / "P03" / f"1-{first}.jsonl"
+    assert again.with_name(f"{again.name}.superseded-1").read_text() == again.read_text()  # same seed, same session
+
+
+def test_status_and_report_of_a_partly_run_study(folder, tmp_path, capsys):
+    copy = tmp_path / "records"
+    shutil.copytree(folder, copy)
+    assert study_cli(copy, "run", "--participant", "P04", "--abort", "fire alarm") == 0
+    capsys.readouterr()
+    assert study_cli(copy, "status") == 0
+    status = capsys.readouterr().out
+    assert "9 done" in status and "1 aborted" in status and "fire alarm" in status
+    assert "orders of the 3 participants who finished every session: positions balanced, carry-over not" in status
+
+    assert study_cli(copy, "report", "--out", str(tmp_path / "report")) == 0
+    report = tmp_path / "report"
+    with open(report / "turns.csv") as handle:
+        turns = list(csv.DictReader(handle))
+    recorded = sum(len(read_session(path)[1]) for path in copy.glob("P0*/*.jsonl") if "questionnaire" not in path.name)
+    assert len(turns) == recorded == 3 * 3 * 8  # one row per recorded turn
+    assert set(turns[0]) >= {"participant", "condition", "order", "turn", "action", "cost", "answer",
+                             "answer_seconds", "refused", "accuracy"}
+    with open(report / "questionnaire.csv") as handle:
+        assert len(list(csv.DictReader(handle))) == 9 * 3
+    text = (report / "report.md").read_text()
+    assert "| final accuracy | dt-task vs active | 3 |" in text
+    assert "| P04 | 1 | dt-small-budget | aborted | fire alarm |" in text
+    assert "## Order effects" in text
+    for png in ("study-example-curves.png", "study-example-final.png"):
+        assert (report / png).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_refused_attempts_count_unreadable_lines_only():
+    assert refused_attempts({"kind": "answer", "lines": ["blue?", "why", "a fruit"]}) == 1
+    assert refused_attempts({"kind": "answer", "lines": ["a fruit"]}) == 0
+    assert refused_attempts({"kind": "late", "lines": ["zzz"]}) == 1
+    assert refused_attempts({"kind": "none", "lines": []}) == 0
+
+
+def test_a_records_folder_that_cannot_be_written_is_one_line(tmp_path, capsys):
+    blocker = tmp_path / "a-file"
+    blocker.write_text("not a folder")
+    assert study_cli(blocker / "records", "run", "--participant", "P01", "--simulated") == 2
+    error = capsys.readouterr().err.strip()
+    assert "cannot write the participant's folder" in error and "is a file, not a folder" in error
+    assert "\n" not in error
+
+
+def test_a_report_before_anyone_ran_lists_every_session_missing(tmp_path, capsys):
+    assert study_cli(tmp_path / "records", "report", "--out", str(tmp_path / "report")) == 0
+    text = (tmp_path / "report" / "report.md").read_text()
+    assert text.count("| missing |") == 18 and "0 of 18 sessions finished" in text
+    assert (tmp_path / "report" / "turns.csv").read_text().count("\n") == 1  # the header only
+
+
+def test_a_transcript_moved_to_another_session_is_refused(folder, tmp_path, capsys):
+    copy = tmp_path / "records"
+    shutil.copytree(folder, copy)
+    first, second = sorted(p for p in (copy / "P01").glob("[12]-*.jsonl") if "questionnaire" not in p.name)
+    first_text = first.read_text()
+    first.write_text(second.read_text())
+    second.write_text(first_text)
+    assert study_cli(copy, "status") == 2
+    error = capsys.readouterr().err
+    assert str(first) in error and "was the file moved or renamed?" in error

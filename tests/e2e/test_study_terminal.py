@@ -1,0 +1,132 @@
+"""``teachbot study run`` at a real terminal (pexpect): instructions, a session, the questionnaire, a pause."""
+
+import json
+import os
+import sys
+from pathlib import Path
+
+import pexpect
+import pytest
+
+from dialog.transcript import read_session
+from tests.e2e.teach_helpers import answer, next_question
+
+pytestmark = pytest.mark.e2e
+TEACHBOT = str(Path(sys.executable).with_name("teachbot"))
+
+STUDY = """
+name = "terminal"
+seed = 5
+ids = ["T01", "T02"]
+order = "given"
+folder = "records"
+pause = "Take a short break now."
+[orders]
+T01 = ["ask", "quiet"]
+T02 = ["quiet", "ask"]
+[[conditions]]
+name = "ask"
+strategy = "active"
+turns = 3
+budget = 5
+instructions = "Condition ASK: label what the robot points at."
+[[conditions]]
+name = "quiet"
+strategy = "active"
+turns = 3
+budget = 1
+instructions = "Condition QUIET: the robot may ask once."
+[[questionnaire]]
+id = "ease"
+kind = "likert"
+text = "Teaching was easy."
+points = 5
+anchors = ["disagree", "agree"]
+[[questionnaire]]
+id = "notes"
+kind = "text"
+text = "Anything else?"
+"""
+
+
+def spawn_study(cwd: Path, *args):
+    env = dict(os.environ, TERM="dumb", NO_COLOR="1", COLUMNS="200")
+    return pexpect.spawn(TEACHBOT, ["study", *args], cwd=str(cwd), env=env, encoding="utf-8", timeout=120,
+                         dimensions=(50, 200), echo=True)
+
+
+def test_a_participant_runs_a_session_and_a_questionnaire_at_the_terminal(tmp_path):
+    (tmp_path / "study.toml").write_text(STUDY)
+    child = spawn_study(tmp_path, "run", "study.toml", "--participant", "T01", "--no-viewer")
+    child.expect_exact("=== Session 1 of 2 (ask) ===")
+    child.expect_exact("Condition ASK: label what the robot points at.")
+    child.expect_exact("Press Enter to begin.")
+    child.sendline("")
+    for number in range(3):
+        assert next_question(child) == "label"
+        if number == 0:
+            answer(child, "purple elephant", "I didn't understand")
+            child.expect("> ")
+        answer(child, "a fruit", "is a fruit")
+    child.expect_exact("Session over: held-out accuracy")
+    child.expect_exact("1 = disagree ... 5 = agree")
+    child.expect("> ")
+    answer(child, "9", "Please type a whole number from 1 to 5")
+    child.expect("> ")
+    answer(child, "4", "Anything else?")
+    child.expect("> ")
+    answer(child, "it pointed well", "Answers saved (1-ask-questionnaire.jsonl)")
+    child.expect_exact("Take a short break now.")
+    child.sendline("")
+    child.expect_exact("=== Session 2 of 2 (quiet) ===")
+    child.expect_exact("Press Enter to begin.")
+    child.sendline("")
+    assert next_question(child) == "label"
+    child.sendeof()  # the participant leaves mid-session: it is saved and resumes later
+    child.expect_exact("Continue with: teachbot study run study.toml --participant T01")
+    child.expect(pexpect.EOF)
+    child.close()
+    assert child.exitstatus == 0
+
+    folder = tmp_path / "records" / "T01"
+    header, records = read_session(folder / "1-ask.jsonl")
+    assert header["study"]["participant"] == "T01" and header["study"]["condition"] == "ask"
+    assert header["study"]["order"] == 1 and header["teacher"] == {"kind": "terminal"}
+    assert [r["answer"]["parsed"] for r in records] == ["fruit"] * 3
+    assert records[0]["answer"]["lines"] == ["purple elephant", "a fruit"]
+    lines = [json.loads(line) for line in (folder / "1-ask-questionnaire.jsonl").read_text().splitlines()]
+    assert lines[0]["questionnaire"]["condition"] == "ask"
+    assert lines[1:] == [{"item": "ease", "kind": "likert", "value": 4},
+                         {"item": "notes", "kind": "text", "value": "it pointed well"}]
+    assert not (folder / "2-quiet-questionnaire.jsonl").exists()
+
+    status = spawn_study(tmp_path, "status", "study.toml")
+    status.expect(pexpect.EOF)
+    assert "running 0/3" in status.before and "1 done" in status.before
+
+    child = spawn_study(tmp_path, "run", "study.toml", "--participant", "T01", "--no-viewer")  # goes on
+    child.expect_exact("1 to run now.")
+    child.expect_exact("=== Session 2 of 2 (quiet) ===")
+    child.expect_exact("(This session was interrupted after 0 turns; it goes on from there.)")
+    child.sendline("")
+    assert next_question(child) == "label"
+    answer(child, "a snack", "is a snack")
+    child.expect_exact("1 = disagree ... 5 = agree")
+    child.expect("> ")
+    answer(child, "skip", "Anything else?")
+    child.expect("> ")
+    answer(child, "", "Answers saved (2-quiet-questionnaire.jsonl)")
+    child.expect_exact("T01: all sessions done for now.")
+    child.expect(pexpect.EOF)
+    child.close()
+    assert child.exitstatus == 0
+    records = read_session(folder / "2-quiet.jsonl")[1]
+    assert len(records) == 3 and records[0]["answer"]["parsed"] == "snack"
+    assert [r["action"]["kind"] for r in records[1:]] == ["none", "none"]  # budget 1: one question
+    answers = [json.loads(line) for line in (folder / "2-quiet-questionnaire.jsonl").read_text().splitlines()[1:]]
+    assert [a["value"] for a in answers] == [None, None]
+
+    again = spawn_study(tmp_path, "run", "study.toml", "--participant", "T01")
+    again.expect(pexpect.EOF)
+    again.close()
+    assert again.exitstatus == 2 and "already done every session" in again.before
