@@ -75,7 +75,8 @@ def perception_check(kitchens=("kitchen-1", "kitchen-2", "kitchen-3"), task: str
             feature_count = len(scene.feature_names)
             scene_index += 1
             if progress:
-                progress(f"{name}: scene {scene_index}, {len(kinds)} objects")
+                progress(f"{name}: scene {scene_index}: {scene.n_objects} objects in this scene, {len(kinds)} in "
+                         f"total so far (of at least {min_objects})")
     finally:
         for world in worlds.values():
             world.close()

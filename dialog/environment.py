@@ -97,8 +97,8 @@ class SimulatedKitchen:
     """A PyBullet kitchen with the Panda: real rendering, perception, pointing and fetching."""
 
     def __init__(self, task: str = "pack-lunchbox", kitchen: str = "kitchen-1", seed: int = 0,
-                 pictures: bool = False):
-        self.world = World(task=task, kitchen=kitchen, seed=seed)
+                 pictures: bool = False, objects_per_scene: int | None = None):
+        self.world = World(task=task, kitchen=kitchen, seed=seed, objects_per_scene=objects_per_scene)
         self.arm = Arm(self.world)
         self.concepts = self.world.task.concepts
         self.feature_names = self.world.feature_names

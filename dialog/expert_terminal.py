@@ -42,7 +42,8 @@ TABLE_KEY = ("ACD discriminability · CDU class uniformity · IV instance variat
 
 def help_text() -> str:
     """The commands, and every column of the candidates table explained."""
-    lines = [COMMANDS, "Columns (query rows show each feature's expected change against staying quiet; "
+    lines = [COMMANDS, "Columns (the 'none' row is the next turn if the robot stays quiet: one turn on, quiet "
+                       "time up, nothing learned; query rows show each feature's expected change against it; "
                        "all features lie in 0..1):"]
     lines += [f"  {name:<14} {meaning}" for name, meaning in COLUMN_MEANINGS.items()]
     return "\n".join(lines)

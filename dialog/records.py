@@ -101,7 +101,10 @@ def _is_number(value) -> bool:
 
 
 def _refuse(field_name: str, value, expected: str) -> TranscriptError:
-    return TranscriptError(f"'{field_name}' is {json.dumps(value)[:80]} (expected {expected})")
+    shown = json.dumps(value)
+    if len(shown) > 80:  # a long value is shortened, and says so
+        shown = f"{shown[:80]}... ({len(shown)} characters)"
+    return TranscriptError(f"'{field_name}' is {shown} (expected {expected})")
 
 
 def check_turn_record(record: dict, expected_turn: int, turns: int, concepts, feature_names) -> None:

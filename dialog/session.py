@@ -19,9 +19,10 @@ from dialog.records import check_turn_record
 from dialog.settings import EpisodeSettings
 from dialog.teachers import SCRIPTED_OPTIONS, make_teacher
 from dialog.transcript import VERSION, TranscriptWriter, read_numbered_session
+from dialog.user_weights import weights_from_header
 from learning.actions import DEFAULT_COSTS
 from learning.errors import DataFileError, SettingsError, TranscriptError
-from learning.strategies import STRATEGY_NAMES, make_strategy
+from learning.strategies import STRATEGY_NAMES
 
 TEACHERS = ("terminal", "scripted", "replay")  # the kinds a teach session records
 
@@ -46,7 +47,8 @@ class SessionSettings(EpisodeSettings):
             raise SettingsError("a replay teacher needs the transcript to replay (--replay FILE)")
 
     def header(self) -> dict:
-        return {"command": "teach", "task": self.task, "kitchen": self.kitchen, "teacher": dict(self.teacher)}
+        header = {"command": "teach", "task": self.task, "kitchen": self.kitchen, "teacher": dict(self.teacher)}
+        return header if self.weights is None else header | {"weights": dict(self.weights)}
 
     @classmethod
     def from_header(cls, header: dict | None, path) -> SessionSettings:
@@ -101,6 +103,7 @@ def check_header(header: dict, path) -> None:
     if "features" in header and not (_is_int(header["features"]) and header["features"] >= 1):
         raise refuse("features", "the number of features, at least 1")
     _check_teacher(header.get("teacher", {"kind": "terminal"}), refuse)
+    weights_from_header(header.get("weights"), path)
 
 
 def _check_teacher(teacher, refuse) -> None:
@@ -188,7 +191,7 @@ def open_session(settings: SessionSettings, environment, transcript_path: str | 
     clock = make_clock(settings, start)
     teacher = session_teacher(settings, rngs, clock, input_stream, output_stream)
     transcript = TranscriptWriter(transcript_path, append=resume, lock=lock)
-    manager = DialogManager(environment, teacher, make_strategy(settings.strategy), settings.config(pictures),
+    manager = DialogManager(environment, teacher, settings.build_strategy(), settings.config(pictures),
                             transcript, rngs, say=say or print, observers=observers, clock=clock,
                             session=settings.header())
     try:

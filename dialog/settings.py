@@ -55,6 +55,7 @@ class EpisodeSettings:
     realtime: float | None = None
     fetch_from_pantry: bool = True
     costs: dict = field(default_factory=lambda: dict(DEFAULT_COSTS))
+    weights: dict | None = None  # DT with a user's weights: {"file": path, "values": {feature: weight}} (--weights)
 
     def __post_init__(self):
         for name, value in (("task", self.task), ("kitchen", self.kitchen), ("strategy", self.strategy)):
@@ -64,6 +65,19 @@ class EpisodeSettings:
         if not isinstance(self.fetch_from_pantry, bool):
             raise SettingsError(f"fetch_from_pantry must be true or false, got {self.fetch_from_pantry!r}")
         check_costs(self.costs)
+        if self.weights is not None:
+            from dialog.user_weights import weights_from_record
+
+            weights_from_record(self.weights)
+
+    def build_strategy(self):
+        """The episode's strategy: the named one, or DT with the recorded user weights (shown as ``strategy``)."""
+        from dialog.user_weights import weights_from_record
+        from learning.strategies import make_strategy
+
+        if self.weights is None:
+            return make_strategy(self.strategy)
+        return weights_from_record(self.weights).strategy(self.strategy)
 
     def config(self, pictures: str | None = None):
         """The manager's allocation for this episode (``pictures``: folder for scene pictures, None: none)."""

@@ -137,7 +137,8 @@ def read_numbered_session(path: str | Path, tolerate_partial_tail: bool = False
         except json.JSONDecodeError as error:
             if tolerate_partial_tail and number == len(lines) and not line.endswith("\n"):
                 break
-            raise TranscriptError(f"{path}: line {number} is not a JSON record ({error.msg})") from None
+            raise TranscriptError(f"{path}: line {number} is not a JSON record: {json_problem(error, line)}; every "
+                                  "line of a transcript is one JSON object, as teachbot writes it") from None
         if not isinstance(record, dict):
             raise TranscriptError(f"{path}: line {number} is not a JSON object")
         if "session" in record:
@@ -151,6 +152,16 @@ def read_numbered_session(path: str | Path, tolerate_partial_tail: bool = False
             raise TranscriptError(f"{path}: line {number} has no 'turn'")
         records.append((number, record))
     return header, records
+
+
+def json_problem(error: json.JSONDecodeError, line: str) -> str:
+    """What the JSON decoder found and where, in full: "invalid control character '\\t' at column 12"."""
+    reason = error.msg[0].lower() + error.msg[1:]
+    reason = reason.removesuffix(" at").removesuffix(":")
+    text = line.rstrip("\r\n")
+    if error.pos >= len(text):
+        return f"{reason} at the end of the line (column {len(text) + 1})"
+    return f"{reason} {text[error.pos]!r} at column {error.pos + 1}"
 
 
 def read_session(path: str | Path, tolerate_partial_tail: bool = False) -> tuple[dict | None, list[dict]]:

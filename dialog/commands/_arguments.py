@@ -3,8 +3,56 @@
 from __future__ import annotations
 
 import argparse
+import re
+import textwrap
 
+from bullet_world.datafiles import available
 from dialog.settings import DEFAULTS, EpisodeSettings
+
+
+class HelpFormatter(argparse.HelpFormatter):
+    """argparse's help, but a name such as ``sort-groceries`` is never split across lines at its hyphen."""
+
+    def _split_lines(self, text, width):
+        return textwrap.wrap(" ".join(text.split()), width, break_on_hyphens=False)
+
+    def _fill_text(self, text, width, indent):
+        return textwrap.fill(" ".join(text.split()), width, initial_indent=indent, subsequent_indent=indent,
+                             break_on_hyphens=False)
+
+
+class TeachbotParser(argparse.ArgumentParser):
+    """An argument parser whose errors are one line in the tool's voice: ``teachbot demo: --seed: ...``, exit 2."""
+
+    def __init__(self, *args, **kwargs):
+        kwargs.setdefault("formatter_class", HelpFormatter)
+        super().__init__(*args, **kwargs)
+
+    def error(self, message: str):
+        self.exit(2, f"{self.prog}: {own_voice(message, self.prog)}\n")
+
+
+def own_voice(message: str, prog: str) -> str:
+    """argparse's wording (``argument --x: invalid choice: ...``) said the way the rest of the tool says things."""
+    choice = re.fullmatch(r"argument (\S+): invalid choice: '(.*)' \(choose from (.*)\)", message, re.S)
+    if choice:
+        accepted = ", ".join(name.strip().strip("'") for name in choice.group(3).split(","))
+        return f"{choice.group(1)}: '{choice.group(2)}' is not one of the accepted names: {accepted}"
+    value = re.fullmatch(r"argument (\S+): invalid (\w+) value: '(.*)'", message, re.S)
+    if value:
+        what = {"int": "a whole number", "float": "a number"}.get(value.group(2), f"a valid {value.group(2)}")
+        return f"{value.group(1)}: '{value.group(3)}' is not {what}"
+    required = re.fullmatch(r"the following arguments are required: (.*)", message, re.S)
+    if required:
+        return f"{required.group(1)} must be given (see {prog} --help)"
+    unknown = re.fullmatch(r"unrecognized arguments: (.*)", message, re.S)
+    if unknown:
+        return f"unknown argument(s) {unknown.group(1)} (see {prog} --help for the accepted ones)"
+    named = re.fullmatch(r"argument (\S+?)(?:/\S+)?: (.*)", message, re.S)
+    if named:
+        problem = "needs a value" if named.group(2) == "expected one argument" else named.group(2)
+        return f"{named.group(1)}: {problem}"
+    return message
 
 
 def _number(text: str, kind, what: str):
@@ -28,6 +76,66 @@ def _at_least(kind, what: str, minimum: float, too_small: str):
     return parse
 
 
+def _whole_number(example: str):
+    """An argparse type: a whole number of 0 or more; the error gives ``example`` of what to write."""
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"'{text}' is not a whole number ({example})") from None
+        if value < 0:
+            raise argparse.ArgumentTypeError(f"'{text}' is negative ({example})")
+        return value
+    return parse
+
+
+seed = _whole_number("give a seed of 0 or more, e.g. --seed 0")
+seeds = _whole_number("give one or more seeds, e.g. --seeds 0 1 2")
+data_seed = _whole_number("give the seed the data sets are rendered from, 0 or more, e.g. --data-seed 1")
+
+
+def task_names() -> list[str]:
+    """The tasks in ``bullet_world/data/tasks``."""
+    return available("tasks")
+
+
+def kitchen_names() -> list[str]:
+    """The kitchens in ``bullet_world/data/kitchens``."""
+    return available("kitchens")
+
+
+def task_name(text: str) -> str:
+    """A task data file's name, or a path to a task .toml file."""
+    if text.endswith(".toml") or text in task_names():
+        return text
+    raise argparse.ArgumentTypeError(f"no task '{text}'; accepted: {', '.join(task_names())} (or a task .toml file)")
+
+
+def kitchen_name(text: str) -> str:
+    """A kitchen's name, or its number (``1`` -> ``kitchen-1``), or a path to a kitchen .toml file."""
+    name = f"kitchen-{text}" if text.isdigit() else text
+    if name.endswith(".toml") or name in kitchen_names():
+        return name
+    numbers = ", ".join(name.removeprefix("kitchen-") for name in kitchen_names())
+    raise argparse.ArgumentTypeError(f"no kitchen '{text}'; accepted: {', '.join(kitchen_names())} (or just the "
+                                     f"number: {numbers}; or a kitchen .toml file)")
+
+
+def add_task_option(parser: argparse.ArgumentParser, default: str | None, help_default: str | None = None) -> None:
+    """``--task NAME``, the accepted names listed in --help."""
+    parser.add_argument("--task", default=default, type=task_name, metavar="TASK",
+                        help=f"task: {', '.join(task_names())} or a .toml file (default {help_default or default})")
+
+
+def add_kitchen_option(parser: argparse.ArgumentParser, default: str | None, default_text: str | None = None,
+                       **extra) -> None:
+    """``--kitchen NAME`` (or its number), the accepted names listed in --help; ``extra`` goes to add_argument."""
+    numbers = ", ".join(name.removeprefix("kitchen-") for name in kitchen_names())
+    parser.add_argument("--kitchen", default=default, type=kitchen_name, metavar="KITCHEN",
+                        help=f"kitchen: {', '.join(kitchen_names())}, or just its number ({numbers}) "
+                             f"(default {default_text or default})", **extra)
+
+
 positive_int = _at_least(int, "a whole number", 1, "expected a whole number of at least 1, got {value}")
 budget = _at_least(float, "a number of cost units", 0, "the budget can't be negative, got {value:g}")
 seconds = _at_least(float, "a number of seconds", 0, "expected zero or more seconds, got {value:g}")
@@ -43,7 +151,7 @@ def positive_seconds(text: str) -> float:
 def add_episode_options(parser: argparse.ArgumentParser, strategies, default_strategy: str,
                         defaults: EpisodeSettings = DEFAULTS) -> None:
     """--seed --turns --budget --change-every --strategy --task --kitchen, their defaults read from ``defaults``."""
-    parser.add_argument("--seed", type=int, default=defaults.seed,
+    parser.add_argument("--seed", type=seed, default=defaults.seed,
                         help=f"one seed for every random choice (default {defaults.seed})")
     parser.add_argument("--turns", type=positive_int, default=defaults.turns,
                         help=f"time allocation T in turns (default {defaults.turns})")
@@ -53,6 +161,5 @@ def add_episode_options(parser: argparse.ArgumentParser, strategies, default_str
                         help=f"a new scene every r turns (default {defaults.change_every})")
     parser.add_argument("--strategy", default=default_strategy, choices=strategies,
                         help=f"questioning strategy (default {default_strategy})")
-    parser.add_argument("--task", default=defaults.task, help=f"task data file name (default {defaults.task})")
-    parser.add_argument("--kitchen", default=defaults.kitchen,
-                        help=f"kitchen data file name (default {defaults.kitchen})")
+    add_task_option(parser, defaults.task)
+    add_kitchen_option(parser, defaults.kitchen)

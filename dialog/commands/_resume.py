@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from dialog.user_weights import check_weights_unchanged, weights_from_header
 from learning.errors import TranscriptError
 
 # option: (attribute of the parsed arguments, the recorded session's value of it)
@@ -24,6 +25,7 @@ SESSION_OPTIONS = {
     "--feature-quality": ("feature_quality", lambda s: s.teacher.get("feature_quality", 1.0)),
     "--answer-delay": ("answer_delay", lambda s: s.teacher.get("answer_delay", 0.0)),
     "--no-fetch": ("no_fetch", lambda s: not s.fetch_from_pantry),
+    "--weights": ("weights", lambda s: None if s.weights is None else s.weights["file"]),
 }
 
 
@@ -36,7 +38,7 @@ def teach_defaults() -> argparse.Namespace:
 
 def _same(given, recorded) -> bool:
     if isinstance(given, Path) or isinstance(recorded, Path):
-        return recorded is not None and Path(given) == Path(recorded)
+        return recorded is not None and Path(given).resolve() == Path(recorded).resolve()
     return given == recorded
 
 
@@ -56,8 +58,11 @@ def differing_options(args: argparse.Namespace, settings, path: Path, defaults: 
 
 
 def check_resume_options(args: argparse.Namespace, settings, path: Path) -> None:
-    """Refuse options beside --resume that differ from the recorded session, naming each of them."""
+    """Refuse options beside --resume that differ from the recorded session, naming each of them, and a weights
+    file that changed since the session was recorded."""
     differing = differing_options(args, settings, path, teach_defaults())
     if differing:
         raise TranscriptError(f"{path}: a resumed session keeps its recorded settings, but {'; '.join(differing)} "
                               "differ; leave them out, or start a new session without --resume")
+    if settings.weights is not None:
+        check_weights_unchanged(weights_from_header(settings.weights, path), path)

@@ -8,13 +8,16 @@ from dataclasses import asdict
 from pathlib import Path
 
 from dialog.commands._arguments import add_episode_options
+from dialog.commands._summary import questions_in_words
 from dialog.commands._viewer import add_viewer_option, hold_viewer, viewer_observers
+from dialog.commands.teach import DEFAULT_STRATEGY
 from dialog.environment import SimulatedKitchen
 from dialog.manager import DialogManager, episode_generators
 from dialog.settings import EpisodeSettings
 from dialog.teachers import OracleTeacher
 from dialog.transcript import FORMAT, TranscriptWriter
 from dialog.transcript_lock import TranscriptLock
+from dialog.user_weights import WEIGHTS_STRATEGY_NAME, add_weights_option, weights_strategy
 from learning.errors import TranscriptError
 from learning.strategies import STRATEGY_NAMES, make_strategy
 
@@ -22,10 +25,15 @@ SUMMARY_KEYS = ("seed", "strategy", "turns", "budget_spent", "queries", "accurac
 
 
 def register(commands) -> None:
-    parser = commands.add_parser("demo", help="run one scripted teaching episode in the simulated kitchen")
-    add_episode_options(parser, STRATEGY_NAMES, "active")
+    parser = commands.add_parser(
+        "demo", help="run one scripted teaching episode in the simulated kitchen",
+        description="A scripted teacher (an oracle) answers the robot's questions for one episode in the simulated "
+                    "kitchen; the summary gives the accuracy on held-out scenes, the budget spent and the questions "
+                    "asked. Every turn goes to a transcript (JSON Lines); the same seed gives the same transcript.")
+    add_episode_options(parser, STRATEGY_NAMES, DEFAULT_STRATEGY)
     parser.add_argument("--transcript", type=Path, default=None,
                         help="transcript path (default runs/demo-<strategy>-seed<seed>.jsonl)")
+    add_weights_option(parser)
     add_viewer_option(parser)
     parser.add_argument("--json", action="store_true", help="end with one JSON line summarising the episode")
     parser.set_defaults(handler=run)
@@ -51,6 +59,11 @@ def refuse_foreign_transcript(path: Path, lock: TranscriptLock) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    args.strategy, weights = weights_strategy(args.strategy, args.weights)  # --weights: DT shown as "dt"
+    strategy = make_strategy(args.strategy) if weights is None else weights.strategy(WEIGHTS_STRATEGY_NAME)
+    session = {"command": "demo"} if weights is None else {"command": "demo", "weights": weights.record()}
+    if weights is not None:
+        print(f"Strategy {WEIGHTS_STRATEGY_NAME}: DT with the weights in {weights.describe()}", flush=True)
     settings = EpisodeSettings(task=args.task, kitchen=args.kitchen, strategy=args.strategy, seed=args.seed,
                                turns=args.turns, budget=args.budget, change_every=args.change_every)
     config = settings.config()
@@ -64,8 +77,8 @@ def run(args: argparse.Namespace) -> int:
             with viewer_observers(args, environment.world) as observers:
                 with TranscriptWriter(transcript_path, lock=lock) as transcript:
                     manager = DialogManager(environment, OracleTeacher(rngs["teacher"]),
-                                            make_strategy(args.strategy), config, transcript, rngs,
-                                            observers=observers, session={"command": "demo"})
+                                            strategy, config, transcript, rngs,
+                                            observers=observers, session=session)
                     result = manager.run()
                 _print_summary(args, result, environment)
                 hold_viewer(args, observers[0] if observers else None)
@@ -79,7 +92,8 @@ def run(args: argparse.Namespace) -> int:
 def _print_summary(args: argparse.Namespace, result, environment) -> None:
     print(f"\nAccuracy on {args.task} held-out scenes: {result.accuracy:.1%} "
           f"(chance {1 / len(environment.concepts):.0%}); budget spent {result.budget_spent:g} of {args.budget:g}; "
-          f"queries {result.queries}; {result.seconds:.1f} s. Transcript: {result.transcript}", flush=True)
+          f"questions: {questions_in_words(result.queries)}; {result.seconds:.1f} s. Transcript: {result.transcript}",
+          flush=True)
     if args.json:
         summary = {key: asdict(result)[key] for key in SUMMARY_KEYS}
         summary["queries"] = {kind: summary["queries"][kind] for kind in ("label", "demo", "feature", "none")}

@@ -7,7 +7,7 @@ import json
 import sys
 from pathlib import Path
 
-from dialog.commands._arguments import budget, positive_int
+from dialog.commands._arguments import add_kitchen_option, add_task_option, budget, positive_int, seed
 from dialog.expert import ExpertSettings
 from learning.actions import DEFAULT_COSTS
 
@@ -37,8 +37,8 @@ def register(commands) -> None:
                     "(fraction of turns left), quiet (time since the last question); 'help' in a session explains "
                     "each. Defaults are the thesis's training condition (§7.4.1).")
     defaults = ExpertSettings()
-    parser.add_argument("--task", default=defaults.task, help=f"task (default {defaults.task})")
-    parser.add_argument("--kitchen", default=defaults.kitchen, help=f"kitchen (default {defaults.kitchen})")
+    add_task_option(parser, defaults.task)
+    add_kitchen_option(parser, defaults.kitchen)
     parser.add_argument("--budget", type=budget, default=defaults.budget,
                         help=f"query budget (default {defaults.budget:g})")
     parser.add_argument("--turns", type=positive_int, default=defaults.turns, help=f"turns (default {defaults.turns})")
@@ -46,7 +46,7 @@ def register(commands) -> None:
                         help=f"a new scene every r turns (default {defaults.change_every})")
     parser.add_argument("--costs", type=costs, default=dict(defaults.costs), metavar="DQ=2,FSQ=2,LQ=1,NQ=0",
                         help="query costs (default DQ 2, FSQ 2, LQ 1, NQ 0)")
-    parser.add_argument("--seed", type=int, default=defaults.seed,
+    parser.add_argument("--seed", type=seed, default=defaults.seed,
                         help=f"one seed for every random choice (default {defaults.seed})")
     parser.add_argument("--out", type=Path, default=Path("runs") / "expert", metavar="DIR",
                         help="directory for the demonstration (.json) and the transcript (.jsonl)")

@@ -22,7 +22,7 @@ import time
 import numpy as np
 
 from bullet_world.recipes.setup import load_recipe_setup
-from dialog.commands._arguments import positive_int
+from dialog.commands._arguments import add_kitchen_option, add_task_option, positive_int, seed
 from dialog.commands._viewer import add_viewer_option, hold_viewer, start_viewer, stop_viewer
 from dialog.recipe_session import (
     NarratedRecipeWorld,
@@ -42,13 +42,15 @@ CAPTION_DWELL_S = 1.5  # seconds each caption holds in an exported page (--viewe
 
 
 def register(commands) -> None:
-    parser = commands.add_parser("recipe", help="learn a recipe from demonstrations and carry it out with the arm")
+    parser = commands.add_parser(
+        "recipe", help="learn a recipe from demonstrations and carry it out with the arm",
+        description="A scripted teacher demonstrates the recipe --demos times; the robot finds the object moved in "
+                    "every step, fits a Gaussian-mixture model per recipe parameter and prints them. --execute then "
+                    "carries the recipe out with the arm in a new arrangement.")
     parser.add_argument("--recipe", default="serve-pasta",
                         help=f"built-in recipe ({', '.join(builtin_recipe_names())}) or a recipe .toml file")
-    parser.add_argument("--task", default=None,
-                        help="task file with the recipe's scenes (default: the recipe's name)")
-    parser.add_argument("--kitchen", default="kitchen-1", type=kitchen_name,
-                        help="kitchen name or number (default kitchen-1)")
+    add_task_option(parser, None, help_default="the recipe's name")
+    add_kitchen_option(parser, "kitchen-1")
     parser.add_argument("--demos", type=positive_int, default=5, help="demonstrations to learn from (default 5)")
     parser.add_argument("--execute", action="store_true", help="carry the recipe out with the arm afterwards")
     parser.add_argument("--lighting", default=None,
@@ -60,15 +62,10 @@ def register(commands) -> None:
     parser.add_argument("--grasp", choices=GRASP_MODES, default=GRASP_MODES[0], help="grasp mode (default friction)")
     parser.add_argument("--tau", type=positive_float, default=DEFAULT_TAU,
                         help=f"Mahalanobis threshold (default {DEFAULT_TAU:g})")
-    parser.add_argument("--seed", type=int, default=0, help="one seed for every random choice (default 0)")
+    parser.add_argument("--seed", type=seed, default=0, help="one seed for every random choice (default 0)")
     add_viewer_option(parser)
     parser.add_argument("--json", action="store_true", help="end with one JSON line summarising the run")
     parser.set_defaults(handler=run)
-
-
-def kitchen_name(text: str) -> str:
-    """"1" -> "kitchen-1"; names pass through."""
-    return f"kitchen-{text}" if text.isdigit() else text
 
 
 def positive_float(text: str) -> float:

@@ -10,22 +10,33 @@ import argparse
 import json
 from pathlib import Path
 
-from dialog.commands._arguments import budget, positive_int
-from dialog.experiments.baseline import baseline_path, write_baseline
+from dialog.commands._arguments import budget, data_seed, positive_int, seeds
+from dialog.experiments.baseline import baseline_path, refuse_other_data_seed, write_baseline
 from dialog.experiments.kinds import RunOptions, get_kind, run_suite
 from dialog.experiments.suite import load_suite, suite_names
 from dialog.output_paths import check_writable, writing
+from dialog.user_weights import named_weights, read_named_weights
 from learning.strategies import STRATEGY_NAMES
 
 
 def register(commands) -> None:
-    parser = commands.add_parser("regress", help="run a regression suite with scripted teachers")
+    parser = commands.add_parser(
+        "regress", help="run a regression suite with scripted teachers",
+        description="Run every episode of a suite (strategies x conditions x seeds) with scripted teachers, write "
+                    "learning curves, tables with significance tests and plots to the results folder, and compare "
+                    "with the stored baseline (--check exits 1 on a regression).")
     parser.add_argument("--suite", required=True, help=f"suite name ({', '.join(suite_names())}) or a .toml path")
     parser.add_argument("--results", type=Path, default=None, help="results folder (default results/<suite>)")
     parser.add_argument("--strategies", nargs="+", default=None, help="run only these strategies")
-    parser.add_argument("--seeds", nargs="+", type=int, default=None, help="override the suite's seeds")
+    parser.add_argument("--seeds", nargs="+", type=seeds, default=None, help="override the suite's seeds")
     parser.add_argument("--budget", type=budget, default=None, help="override every condition's budget")
     parser.add_argument("--datasets", type=positive_int, default=None, help="override the number of data sets")
+    parser.add_argument("--data-seed", type=data_seed, default=None, metavar="N",
+                        help="render (once, then cached) and use the task's data sets from seed N instead of the "
+                             "suite's (default: the suite's data_seed, 0 unless it says otherwise)")
+    parser.add_argument("--weights", type=named_weights, action="append", default=None, metavar="NAME=FILE",
+                        help="add a DT strategy called NAME with the weights in FILE (as teachbot learn-weights "
+                             "writes them); repeatable")
     parser.add_argument("--workers", type=positive_int, default=None, help="local worker processes (default: cores)")
     parser.add_argument("--ray", metavar="ADDRESS", default=None,
                         help="run the episodes on the Ray cluster at ADDRESS ('local' starts one here)")
@@ -37,10 +48,12 @@ def register(commands) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    original = load_suite(args.suite, known_strategies=STRATEGY_NAMES)
+    original = load_suite(args.suite, known_strategies=STRATEGY_NAMES).with_weights(read_named_weights(args.weights))
     kind = get_kind(original.kind)
     suite = kind.load(original.with_overrides(strategies=args.strategies, seeds=args.seeds, budget=args.budget,
-                                              datasets=args.datasets))
+                                              datasets=args.datasets, data_seed=args.data_seed))
+    if args.check:
+        refuse_other_data_seed(suite)  # before anything runs
     out = args.results or Path("results") / suite.name
     check_writable(out, "results", folder=True)
     with writing(out, "results", inside=True):
@@ -56,9 +69,12 @@ def run(args: argparse.Namespace) -> int:
         with writing(baseline_path(suite), "baseline"):
             print(f"baseline written to {write_baseline(suite, outcome.summaries)}")
     failures = kind.check(outcome) if args.check else []
+    if args.check and suite.weights:
+        print(f"  not checked (--weights strategies, no baseline): {', '.join(suite.weights)}")
     for failure in failures:
         print(f"  REGRESSION {failure}")
     if args.json:
+        data = {} if suite.kind == "recipes" else {"data_seed": suite.data_seed}  # recipes render no data sets
         print(json.dumps({"suite": suite.name, "episodes": outcome.count, "seconds": round(outcome.seconds, 2),
-                          "passed": not failures, "failures": failures}))
+                          **data, "passed": not failures, "failures": failures}))
     return 1 if failures else 0

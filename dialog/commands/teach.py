@@ -9,12 +9,14 @@ from pathlib import Path
 
 from dialog.commands._arguments import add_episode_options, budget, positive_seconds
 from dialog.commands._resume import check_resume_options
+from dialog.commands._summary import questions_in_words, session_time
 from dialog.commands._viewer import add_viewer_option, hold_viewer, start_viewer, stop_viewer
 from dialog.environment import SimulatedKitchen
 from dialog.output_paths import check_writable
 from dialog.session import TEACHERS, SessionSettings, open_session
 from dialog.transcript import read_session
 from dialog.transcript_lock import TranscriptLock
+from dialog.user_weights import add_weights_option, weights_strategy
 from learning.errors import OutputPathError, SettingsError, TranscriptError
 from learning.strategies import STRATEGY_NAMES
 
@@ -62,13 +64,14 @@ def register(commands) -> None:
     parser.add_argument("--no-pictures", action="store_true", help="write no scene pictures")
     parser.add_argument("--no-fetch", action="store_true",
                         help="never fetch an absent example from the pantry")
+    add_weights_option(parser)
     add_viewer_option(parser)
     parser.add_argument("--json", action="store_true", help="end with one JSON line summarising the session")
     parser.set_defaults(handler=run)
 
 
-def _default_transcript(args) -> Path:
-    base = Path("runs") / f"teach-{args.task}-{args.strategy}-seed{args.seed}"
+def _default_transcript(args, strategy: str) -> Path:
+    base = Path("runs") / f"teach-{args.task}-{strategy}-seed{args.seed}"
     path, number = base.with_suffix(".jsonl"), 2
     while path.exists():
         path, number = Path(f"{base}-{number}.jsonl"), number + 1
@@ -84,7 +87,9 @@ def _settings(args) -> SessionSettings:
         if args.replay is None:
             raise SettingsError("--teacher replay needs --replay FILE (a transcript to answer from)")
         teacher["transcript"] = str(args.replay)
-    return SessionSettings(task=args.task, kitchen=args.kitchen, strategy=args.strategy, seed=args.seed,
+    strategy, weights = weights_strategy(args.strategy, args.weights)  # --weights: DT, shown as "dt"
+    return SessionSettings(task=args.task, kitchen=args.kitchen, strategy=strategy, seed=args.seed,
+                           weights=None if weights is None else weights.record(),
                            turns=args.turns, budget=args.budget, change_every=args.change_every,
                            realtime=args.realtime, fetch_from_pantry=not args.no_fetch, teacher=teacher)
 
@@ -104,7 +109,7 @@ def _claim_transcript(args) -> tuple[SessionSettings, Path, TranscriptLock]:
             lock.release()
             raise
     settings = _settings(args)
-    path = args.transcript or _default_transcript(args)
+    path = args.transcript or _default_transcript(args, settings.strategy)
     lock = TranscriptLock(path)
     if lock.size() > 0:
         lock.release()
@@ -150,7 +155,8 @@ def _teach(args, settings: SessionSettings, path: Path, lock: TranscriptLock, in
                                         observers=() if viewer is None else (viewer,), lock=lock)
         manager.say = _narrator(manager.teacher, out, person)
         intro = (f"Teaching '{settings.task}' ({', '.join(environment.concepts)}) in {settings.kitchen}: "
-                 f"{settings.turns} turns, budget {settings.budget:g}, strategy {settings.strategy}. "
+                 f"{settings.turns} turns, budget {settings.budget:g}, strategy {settings.strategy}"
+                 f"{'' if settings.weights is None else ' with the weights in ' + settings.weights['file']}. "
                  f"Transcript: {path}")
         if records:
             intro += f" (resuming after turn {len(records)})"
@@ -178,7 +184,8 @@ def _teach(args, settings: SessionSettings, path: Path, lock: TranscriptLock, in
                         f"teachbot teach --resume {path}")
         manager.say(f"Accuracy on {settings.task} held-out scenes: {result.accuracy:.1%} (chance "
                     f"{1 / len(environment.concepts):.0%}); budget spent {result.budget_spent:g} of "
-                    f"{settings.budget:g}; queries {result.queries}; {result.seconds:.1f} s.")
+                    f"{settings.budget:g}; questions: {questions_in_words(result.queries)}; "
+                    f"{session_time(manager.clock, result.seconds, records)}.")
         if args.json:
             print(json.dumps({"seed": result.seed, "strategy": result.strategy, "turns": result.turns,
                               "completed": result.completed, "quit": result.quit, "budget_spent": result.budget_spent,

@@ -15,15 +15,19 @@ import sys
 import time
 from pathlib import Path
 
-from dialog.commands._arguments import positive_int, seconds
+from dialog.commands._arguments import add_kitchen_option, add_task_option, positive_int, seconds, seed
 from learning.errors import SettingsError
 
 
 def register(commands) -> None:
-    parser = commands.add_parser("view", help="show one scene of the kitchen in meshcat (a browser) and print the URL")
-    parser.add_argument("--task", default="pack-lunchbox", help="task data file name (default pack-lunchbox)")
-    parser.add_argument("--kitchen", default="kitchen-1", help="kitchen data file name (default kitchen-1)")
-    parser.add_argument("--seed", type=int, default=0, help="seed of the scene (default 0)")
+    parser = commands.add_parser(
+        "view", help="show one scene of the kitchen in meshcat (a browser) and print the URL",
+        description="Mirror the first scene that 'teachbot demo' shows for the same task, kitchen and seed into "
+                    "meshcat and print its URL; --point N lets the arm point at object N as a label question does. "
+                    "--export and --screenshot write their file and exit unless --serve is given.")
+    add_task_option(parser, "pack-lunchbox")
+    add_kitchen_option(parser, "kitchen-1")
+    parser.add_argument("--seed", type=seed, default=0, help="seed of the scene (default 0)")
     parser.add_argument("--point", type=positive_int, default=None, metavar="N",
                         help="let the arm point at object N and ask about it, as a label question does")
     parser.add_argument("--export", type=Path, default=None, metavar="HTML",
@@ -41,6 +45,7 @@ def register(commands) -> None:
 def run(args: argparse.Namespace) -> int:
     from bullet_world.viewer.mirror import Viewer
     from dialog.commands._viewer import page_path
+    from dialog.commands.world import scene_table
     from dialog.environment import SimulatedKitchen
     from dialog.manager import episode_generators
     from dialog.output_paths import check_writable, writing
@@ -65,6 +70,8 @@ def run(args: argparse.Namespace) -> int:
                       f"from its centre, {gesture['sim_seconds']:.2f} s of simulated motion).")
             print(f"Scene {scene.scene_id} of {args.task} in {args.kitchen} (seed {args.seed}): "
                   f"{scene.n_objects} objects, numbered 1 to {scene.n_objects}.")
+            for line in scene_table(scene, environment):
+                print(f"  {line}")
             print(f"Viewer: {viewer.url}")
             if export is not None:
                 with writing(export, "scene page"):

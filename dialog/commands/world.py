@@ -8,45 +8,54 @@ import json
 import sys
 from pathlib import Path
 
-import numpy as np
-
-from dialog.commands._arguments import positive_int
+from dialog.commands._arguments import add_kitchen_option, add_task_option, kitchen_names, positive_int, seed
 from learning.errors import SettingsError
-
-KITCHENS = ("kitchen-1", "kitchen-2", "kitchen-3")
 
 
 def register(commands) -> None:
-    parser = commands.add_parser("world", help="look at the simulated kitchen: a picture, or a perception check")
+    parser = commands.add_parser(
+        "world", help="look at the simulated kitchen: a scene's objects, a perception check, the data sets",
+        description="Look at the simulated kitchen without the robot learning: 'show' lists one scene's objects "
+                    "(and draws it with --png), 'check' measures perception against the simulator, 'data' builds "
+                    "or loads a task's data sets.")
     actions = parser.add_subparsers(dest="action", required=True, metavar="ACTION")
 
-    show = actions.add_parser("show", help="write an annotated camera picture of one scene")
-    show.add_argument("--kitchen", default="kitchen-1", help="kitchen data file name (default kitchen-1)")
-    show.add_argument("--task", default="pack-lunchbox", help="task data file name (default pack-lunchbox)")
-    show.add_argument("--seed", type=int, default=0, help="seed of the scene (default 0)")
+    show = actions.add_parser(
+        "show", help="list one scene's objects as a table (and write an annotated picture with --png)",
+        description="The first scene that 'teachbot demo' and 'teachbot view' show for the same task, kitchen and "
+                    "seed, as a table: object number, kind and concept, colour, size, location. --png also writes "
+                    "the annotated camera picture.")
+    add_kitchen_option(show, "kitchen-1")
+    add_task_option(show, "pack-lunchbox")
+    show.add_argument("--seed", type=seed, default=0, help="seed of the scene (default 0)")
     show.add_argument("--objects", type=positive_int, default=None,
                       help="objects in the scene (default: the task's objects_per_scene)")
     show.add_argument("--stage", type=int, default=None,
-                      help="state stage for tasks whose objects change state (default: random states)")
-    show.add_argument("--png", type=Path, required=True, help="where to write the picture (.png)")
-    show.add_argument("--robot", action="store_true", help="add the arm (its features join the list)")
+                      help="state stage for tasks whose objects change state (default: the first scene's, as "
+                           "demo shows it)")
+    show.add_argument("--png", type=Path, default=None, help="also write the annotated camera picture (.png)")
     show.set_defaults(handler=run_show)
 
-    check = actions.add_parser("check", help="measure perception against the simulator over many objects")
+    check = actions.add_parser(
+        "check", help="measure perception against the simulator over many objects",
+        description="Build scenes until at least --objects objects were seen and compare the perceived size and "
+                    "location of each with the simulator's ground truth, per object kind.")
     check.add_argument("--objects", type=positive_int, default=500, help="objects to measure at least (default 500)")
     check.add_argument("--per-scene", type=positive_int, default=55, help="objects per scene (default 55)")
-    check.add_argument("--task", default="pack-lunchbox", help="task data file name (default pack-lunchbox)")
-    check.add_argument("--kitchen", action="append", choices=KITCHENS, default=None,
-                       help="kitchen(s) to use, repeatable (default: all three)")
-    check.add_argument("--seed", type=int, default=0, help="seed of the first scene (default 0)")
+    add_task_option(check, "pack-lunchbox")
+    add_kitchen_option(check, None, "all of them; repeat --kitchen for several", action="append")
+    check.add_argument("--seed", type=seed, default=0, help="seed of the first scene (default 0)")
     check.add_argument("--no-robot", action="store_true", help="leave the arm out (its features too)")
     check.add_argument("--json", action="store_true", help="end with one JSON line of the results")
     check.set_defaults(handler=run_check)
 
-    data = actions.add_parser("data", help="build (or load from the cache) a task's data sets and summarise them")
-    data.add_argument("--task", default="pack-lunchbox", help="task data file name (default pack-lunchbox)")
-    data.add_argument("--kitchen", default="kitchen-1", choices=KITCHENS, help="kitchen (default kitchen-1)")
-    data.add_argument("--seed", type=int, default=0, help="seed of the data sets (default 0)")
+    data = actions.add_parser(
+        "data", help="build (or load from the cache) a task's data sets and summarise them",
+        description="Render a task's training pools and test pool in the simulator (or load them from the cache) "
+                    "and print their sizes; the regression suites use the same data sets.")
+    add_task_option(data, "pack-lunchbox")
+    add_kitchen_option(data, "kitchen-1")
+    data.add_argument("--seed", type=seed, default=0, help="seed of the data sets (default 0)")
     data.add_argument("--cache", type=Path, default=None,
                       help="cache folder (default $TEACHBOT_CACHE or ~/.cache/teachbot)")
     data.add_argument("--no-robot", action="store_true", help="leave the arm out (its features too)")
@@ -60,30 +69,60 @@ def register(commands) -> None:
 
 
 def run_show(args: argparse.Namespace) -> int:
-    from bullet_world import World
-    from bullet_world.annotate import annotate, write_png
+    from dialog.environment import SimulatedKitchen
+    from dialog.manager import episode_generators
 
-    if args.png.suffix.lower() != ".png":
+    if args.png is not None and args.png.suffix.lower() != ".png":
         raise SettingsError(f"--png must name a .png file, got '{args.png}'")
-    with World(task=args.task, kitchen=args.kitchen, seed=args.seed, objects_per_scene=args.objects) as world:
-        if args.robot:
-            from robot import Arm
+    environment = SimulatedKitchen(task=args.task, kitchen=args.kitchen, seed=args.seed, objects_per_scene=args.objects)
+    try:
+        rng = episode_generators(args.seed)["scenes"]  # the stream demo and view draw their first scene from
+        if args.stage is None:
+            scene = environment.next_scene(rng)
+        else:
+            scene = environment.world.new_scene(rng, stage=args.stage)
+        print(f"Scene {scene.scene_id} of {args.task} in {args.kitchen} (seed {args.seed}): {scene.n_objects} "
+              f"objects, {len(scene.feature_names)} features each; places as the teacher across the counter sees them")
+        for line in scene_table(scene, environment):
+            print(f"  {line}")
+        if args.png is not None:
+            from bullet_world.annotate import annotate, write_png
 
-            Arm(world)
-        scene = world.new_scene(np.random.default_rng(args.seed), stage=args.stage)
-        write_png(args.png, annotate(world.images, scene, world.kitchen))
-        print(f"{args.png}: {scene.n_objects} objects in {args.kitchen} ({args.task}, seed {args.seed}), "
-              f"{len(scene.feature_names)} features each")
-        for index, (kind, state) in enumerate(zip(scene.truth.kinds, scene.truth.states)):
-            shown = kind if state == "as-is" else f"{kind} ({state})"
-            print(f"  {index + 1:>2}. {shown:<28} {scene.truth.concepts[index]}")
+            write_png(args.png, annotate(environment.world.images, scene, environment.world.kitchen))
+            print(f"Picture: {args.png}")
+    finally:
+        environment.close()
     return 0
+
+
+def scene_table(scene, environment) -> list[str]:
+    """One line per object: number, kind (and state), concept, perceived colour and size, place and x, y."""
+    from dialog.describe import SceneDescriber
+
+    described = SceneDescriber(scene, environment.locations, environment.viewpoint)
+    width = max([len("object"), *(len(_kind(scene, i)) for i in range(scene.n_objects))])
+    concept_width = max([len("concept"), *map(len, scene.truth.concepts)])
+    lines = [f"{'no.':>3}  {'object':<{width}}  {'concept':<{concept_width}}  {'colour':<11} {'size (cm)':<12} "
+             "x, y (m)      place"]
+    for index in range(scene.n_objects):
+        size = "x".join(f"{v * 100:.0f}" for v in described.sizes[index]) if described.sizes is not None else "?"
+        x, y = scene.positions[index][:2]
+        lines.append(f"{index + 1:>3}  {_kind(scene, index):<{width}}  {scene.truth.concepts[index]:<{concept_width}}  "
+                     f"{described.colour_names[index] or '?':<11} {size:<12} {x:+.2f}, {y:+.2f}  "
+                     f"{described.places[index] or '?'}")
+    return lines
+
+
+def _kind(scene, index: int) -> str:
+    kind = scene.truth.kinds[index]
+    states = scene.truth.states
+    return kind if not states or states[index] == "as-is" else f"{kind} ({states[index]})"
 
 
 def run_check(args: argparse.Namespace) -> int:
     from bullet_world.check import perception_check
 
-    kitchens = tuple(args.kitchen) if args.kitchen else KITCHENS
+    kitchens = tuple(args.kitchen) if args.kitchen else tuple(kitchen_names())
 
     def progress(message: str) -> None:
         print(message, file=sys.stderr, flush=True)

@@ -13,7 +13,7 @@ def test_world_show_writes_an_annotated_picture(tmp_path, capsys):
     picture = cv2.imread(str(out))
     assert picture is not None and picture.shape[0] > 300
     printed = capsys.readouterr().out
-    assert "8 objects in kitchen-2" in printed and " 8. " in printed
+    assert "in kitchen-2 (seed 3): 8 objects" in printed and "\n    8  " in printed and f"Picture: {out}" in printed
 
 
 def test_world_show_refuses_a_bad_file_name(tmp_path, capsys):
@@ -24,8 +24,9 @@ def test_world_show_refuses_a_bad_file_name(tmp_path, capsys):
 def test_world_check_ends_with_one_json_line(capsys):
     assert main(["world", "check", "--objects", "12", "--per-scene", "6", "--kitchen", "kitchen-1",
                  "--json"]) == 0
-    last = capsys.readouterr().out.strip().splitlines()[-1]
-    result = json.loads(last)
+    captured = capsys.readouterr()
+    assert "scene 2: 6 objects in this scene, 12 in total so far (of at least 12)" in captured.err  # totals say so
+    result = json.loads(captured.out.strip().splitlines()[-1])
     assert set(result) >= {"objects", "size_err_mm", "loc_err_mm", "features", "ms_per_scene"}
     assert result["objects"] >= 12 and set(result["size_err_mm"]) == {"median", "p95"}
     assert result["size_err_mm"]["median"] < 5 and result["loc_err_mm"]["median"] < 5

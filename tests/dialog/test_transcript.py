@@ -96,6 +96,32 @@ def test_unreadable_lines_are_transcript_errors(tmp_path):
         read_session(path)
 
 
+def test_a_bad_line_is_described_in_full_with_its_column(tmp_path):
+    from learning.errors import TranscriptError
+
+    path = tmp_path / "t.jsonl"
+    path.write_text('{"turn": 1}\n{"turn": 2, "raw": "a\tb"}\n')
+    with pytest.raises(TranscriptError) as raised:
+        read_session(path)
+    message = str(raised.value)
+    assert message == (f"{path}: line 2 is not a JSON record: invalid control character '\\t' at column 22; every line "
+                       "of a transcript is one JSON object, as teachbot writes it")
+    path.write_text('{"turn": 1}\n{"turn": 2,\n{"turn": 3}\n')
+    with pytest.raises(TranscriptError, match=r"line 2 is not a JSON record: expecting property name enclosed in "
+                                              r"double quotes at the end of the line \(column 12\); every line"):
+        read_session(path)
+
+
+def test_a_long_bad_value_is_shortened_and_says_so():
+    from dialog.records import check_turn_record
+    from learning.errors import TranscriptError
+
+    with pytest.raises(TranscriptError) as raised:
+        check_turn_record(good_record(scene_id=["x" * 200]), 2, 5, ("main dish", "snack", "fruit", "beverage"),
+                          ("f1", "f2", "f3"))
+    assert "... (" in str(raised.value) and "characters)" in str(raised.value)
+
+
 def good_record(**changes):
     record = {"turn": 2, "time": 1.0, "scene_id": 1, "action": {"kind": "label", "object": 3},
               "answer": {"kind": "answer", "raw": "a fruit", "parsed": "fruit", "lines": ["a fruit"], "seconds": 0.5},

@@ -41,7 +41,20 @@ def test_same_seed_twice_gives_byte_identical_transcripts(tmp_path, capsys):
 def test_bad_arguments_are_rejected_with_a_message(capsys):
     with pytest.raises(SystemExit):
         main(["demo", "--strategy", "clever"])
-    assert "invalid choice: 'clever'" in capsys.readouterr().err
+    assert "--strategy: 'clever' is not one of the accepted names: " in capsys.readouterr().err
     with pytest.raises(SystemExit):
         main(["demo", "--turns", "0"])
     assert "at least 1" in capsys.readouterr().err
+
+
+def test_the_summary_counts_questions_in_words_and_the_json_keeps_its_counts(tmp_path, capsys):
+    from dialog.commands._summary import questions_in_words
+
+    assert main(["demo", "--turns", "6", "--budget", "6", "--change-every", "3", "--transcript",
+                 str(tmp_path / "w.jsonl"), "--json"]) == 0
+    lines = capsys.readouterr().out.strip().splitlines()
+    summary = json.loads(lines[-1])
+    assert summary["strategy"] == "dt-task"  # the demo's default
+    assert set(summary["queries"]) == {"label", "demo", "feature", "none"}
+    assert f"questions: {questions_in_words(summary['queries'])};" in lines[-2]
+    assert "{'" not in lines[-2]

@@ -25,13 +25,21 @@ def test_recipe_command_learns_and_carries_out_serve_salad(capsys):
 
 @pytest.mark.parametrize("arguments, message", [
     (["--recipe", "serve-soup"], "unknown built-in recipe 'serve-soup'; accepted: serve-pasta, serve-salad"),
-    (["--kitchen", "9"], "unknown kitchen 'kitchen-9'; available: kitchen-1"),
     (["--recipe", "serve-salad", "--task", "pack-lunchbox"], "has no [recipe_scenes] table"),
 ])
 def test_bad_recipe_input_gets_a_one_line_message(capsys, arguments, message):
     assert main(["recipe", "--demos", "1", *arguments]) == 2
     error = capsys.readouterr().err.strip()
     assert message in error and len(error.splitlines()) == 1
+
+
+def test_an_unknown_kitchen_is_refused_before_any_work(capsys):
+    with pytest.raises(SystemExit) as raised:
+        main(["recipe", "--demos", "1", "--kitchen", "9"])
+    assert raised.value.code == 2
+    error = capsys.readouterr().err.strip()
+    assert error.startswith("teachbot recipe: --kitchen: no kitchen '9'; accepted: kitchen-1, kitchen-2, kitchen-3")
+    assert len(error.splitlines()) == 1
 
 
 def test_zero_demonstrations_are_refused(capsys):
