@@ -161,6 +161,12 @@ class DialogManager:
         )
 
     # -- the clock and the world ---------------------------------------------------
+    def begin_turn(self) -> float:
+        """Start the next turn (the scene changes when it is due) and return its start time; then ``realise``
+        one action. ``play_turn`` does both; a caller that chooses the action itself after seeing the turn's
+        scene (the Gymnasium environment, dialog/gym_env.py) calls them one after the other."""
+        return self._start_turn()
+
     def _start_turn(self, recorded_scene: int | None = None) -> float:
         """Wait for the turn's slot (real time), and change the scene when it is due."""
         config = self.config
