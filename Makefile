@@ -11,7 +11,7 @@ STAMP := $(VENV)/.teachbot-installed
 $(STAMP): pyproject.toml
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet torch==2.13.0
-	$(PY) -m pip install --quiet -e '.[dev,ray]'
+	$(PY) -m pip install --quiet -e '.[dev,ray,rl]'
 	touch $(STAMP)
 
 demo: $(STAMP)

@@ -77,6 +77,31 @@ class TranscriptWriter:
         self.close()
 
 
+class MemoryTranscript:
+    """A transcript kept in memory (``records``, the header first): what the Gymnasium environment records
+    when no file is asked for, so that thousands of training episodes do not each sync a file to disk."""
+
+    path = Path("<memory>")
+
+    def __init__(self) -> None:
+        self.records: list[dict] = []
+
+    @property
+    def has_content(self) -> bool:
+        return bool(self.records)
+
+    def write(self, record: dict) -> None:
+        self.records.append(json.loads(json.dumps(record)))  # what a file would give back
+
+    def write_header(self, session: dict) -> None:
+        if self.records:
+            raise ValueError("the session header must be the first record")
+        self.write({"session": {"format": FORMAT, "version": VERSION, **session}})
+
+    def close(self) -> None:
+        pass
+
+
 def _truncate_quietly(fd: int, size: int) -> None:
     try:
         os.ftruncate(fd, size)

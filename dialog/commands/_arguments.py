@@ -138,6 +138,7 @@ def add_kitchen_option(parser: argparse.ArgumentParser, default: str | None, def
 
 positive_int = _at_least(int, "a whole number", 1, "expected a whole number of at least 1, got {value}")
 budget = _at_least(float, "a number of cost units", 0, "the budget can't be negative, got {value:g}")
+price = _at_least(float, "a number", 0, "the price can't be negative, got {value:g}")
 seconds = _at_least(float, "a number of seconds", 0, "expected zero or more seconds, got {value:g}")
 
 

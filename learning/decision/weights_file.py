@@ -92,7 +92,10 @@ def check_bare_key(key: str) -> bool:
     return bool(key) and all(c.isascii() and (c.isalnum() or c in "_-") for c in key)
 
 
-def _toml_value(value) -> str:
+def toml_value(value) -> str:
+    """One TOML value (boolean, integer, float, string, or a list of these) as text."""
+    if isinstance(value, list | tuple):
+        return "[" + ", ".join(toml_value(item) for item in value) + "]"
     if isinstance(value, bool):
         return "true" if value else "false"
     if isinstance(value, int | np.integer):
@@ -107,10 +110,10 @@ def weights_to_toml(weights: DecisionWeights, comment: str = "") -> str:
     """The TOML text of a weights file (written by hand: two flat tables)."""
     lines = [f"# {line}".rstrip() for line in comment.splitlines()] if comment else []
     lines += [f"[{WEIGHTS_TABLE}]"]
-    lines += [f"{name} = {_toml_value(float(value))}" for name, value in zip(weights.feature_names, weights.values)]
+    lines += [f"{name} = {toml_value(float(value))}" for name, value in zip(weights.feature_names, weights.values)]
     if weights.provenance:
         lines += ["", f"[{PROVENANCE_TABLE}]"]
-        lines += [f"{key} = {_toml_value(value)}" for key, value in weights.provenance.items()]
+        lines += [f"{key} = {toml_value(value)}" for key, value in weights.provenance.items()]
     return "\n".join(lines) + "\n"
 
 

@@ -14,6 +14,7 @@ dt-iros    DT on ACD and CDU (thesis ch. 6)
 dt-task    DT on ACD, CDU, IV and PM (thesis ch. 7)
 dt-task-env DT on all seven decision features (thesis ch. 7; IRL weights)
 scripted-expert the scripted expert of thesis §7.4.1 (rules in data/scripted-expert.toml)
+rl:FILE    a trained questioner policy (teachbot train-questioner; beyond the thesis)
 ========== ==================================================================
 """
 
@@ -30,6 +31,8 @@ from learning.strategies.decision_theoretic import DecisionTheoreticStrategy
 from learning.strategies.hfs import HfsActiveStrategy, HfsPassiveStrategy
 from learning.strategies.passive import PassiveStrategy
 from learning.strategies.random_choice import RandomStrategy
+from learning.strategies.rl_questioner import PREFIX as RL_PREFIX
+from learning.strategies.rl_questioner import RLQuestionerStrategy
 from learning.strategies.scripted_expert import ScriptedExpertStrategy
 
 STRATEGIES: dict[str, Callable[..., Strategy]] = {
@@ -54,9 +57,12 @@ def make_strategy(name: str, **options) -> Strategy:
     Options go to the strategy's constructor, e.g. ``make_strategy("dt", weights={...}, engine="reference")``
     or ``make_strategy("all-cd", examples_per_concept=3)``.
     """
+    if str(name).startswith(RL_PREFIX):  # a policy file: its path keeps its case
+        return RLQuestionerStrategy(str(name)[len(RL_PREFIX):], name=str(name), **options)
     key = str(name).strip().lower()
     if key not in STRATEGIES:
-        raise SettingsError(f"unknown strategy '{name}'; choose one of: {', '.join(STRATEGY_NAMES)}")
+        raise SettingsError(f"unknown strategy '{name}'; choose one of: {', '.join(STRATEGY_NAMES)}, "
+                            f"or {RL_PREFIX}FILE (a trained questioner policy .toml)")
     if key == "dt" and "weights" in options:
         return DecisionTheoreticStrategy(name="dt", **options)
     try:
