@@ -97,7 +97,8 @@ class SimulatedKitchen:
     """A PyBullet kitchen with the Panda: real rendering, perception, pointing and fetching."""
 
     def __init__(self, task: str = "pack-lunchbox", kitchen: str = "kitchen-1", seed: int = 0,
-                 pictures: bool = False, objects_per_scene: int | None = None):
+                 pictures: bool = False, objects_per_scene: int | None = None, joint_speed: float | None = None):
+        self.joint_speed = joint_speed  # rad/s: the arm's gestures paced by a joint-speed limit (embodied costs)
         self.world = World(task=task, kitchen=kitchen, seed=seed, objects_per_scene=objects_per_scene)
         self.arm = Arm(self.world)
         self.concepts = self.world.task.concepts
@@ -143,7 +144,7 @@ class SimulatedKitchen:
 
     def point_at(self, scene: Scene, object_index: int) -> dict:
         """Really move the arm; report where the fingertip ended relative to the object."""
-        result = point_at(self.arm, scene.positions[object_index], scene.tops[object_index])
+        result = point_at(self.arm, scene.positions[object_index], scene.tops[object_index], self.joint_speed)
         self._arm_out = True
         tip = self.arm.fingertip_position()
         offset = tip - scene.truth.positions[object_index]
@@ -227,7 +228,7 @@ class SimulatedKitchen:
         world = self.world
         poses = object_poses(world)
         near = [obj.size[2] for obj in world.objects if np.linalg.norm(obj.xy - xy) <= REACH_CLEARANCE_RADIUS_M]
-        reach = point_at(self.arm, np.array([xy[0], xy[1], 0.0]), max(near, default=0.0))
+        reach = point_at(self.arm, np.array([xy[0], xy[1], 0.0]), max(near, default=0.0), self.joint_speed)
         self.arm.rest()
         restore_poses(world, poses)
         return reach

@@ -16,7 +16,7 @@ import weakref
 
 import numpy as np
 
-from robot.arm import Arm, MotionResult
+from robot.arm import SIM_STEP_SECONDS, Arm, MotionResult
 from robot.kinematics import IkSolution, KinematicTwin
 
 POINTING_CLEARANCE_M = 0.08  # how far above the object's top the fingertip stops
@@ -74,18 +74,37 @@ def plan_via(arm: Arm, position, final: IkSolution, height: float) -> IkSolution
     return None
 
 
-def point_at(arm: Arm, position, top_height: float) -> MotionResult:
+def paced_steps(start, target, steps: int, joint_speed: float | None) -> int:
+    """Simulation steps for a cosine-profiled joint motion from ``start`` to ``target``.
+
+    ``joint_speed`` None: ``steps`` whatever the distance (the fixed-length gesture). Otherwise no joint may
+    exceed ``joint_speed`` rad/s: the profile's peak speed is pi/2 x |dq| / duration, so the motion lasts at
+    least pi/2 x max|dq| / joint_speed seconds (never less than ``steps``): a far reach takes longer.
+    """
+    if joint_speed is None:
+        return steps
+    if not joint_speed > 0:
+        raise ValueError(f"joint_speed must be a positive number of rad/s, got {joint_speed!r}")
+    largest = float(np.max(np.abs(np.asarray(target, dtype=float) - np.asarray(start, dtype=float))))
+    return max(steps, int(np.ceil(np.pi / 2 * largest / joint_speed / SIM_STEP_SECONDS)))
+
+
+def point_at(arm: Arm, position, top_height: float, joint_speed: float | None = None) -> MotionResult:
     """Move the fingertip straight above the object at ``position`` (its perceived centre).
 
     ``reached`` means the fingertip ended within ``HORIZONTAL_TOLERANCE_M`` of the
     object's centre seen from above, at most ``MAX_CLEARANCE_M`` over its top.
+    ``joint_speed`` (rad/s, None: the fixed-length gesture) paces the motion by the
+    arm's joint-speed limit (:func:`paced_steps`), as embodied query costs need.
     """
     final, clearance = plan_pointing(arm, position, top_height)
     via = plan_via(arm, position, final, top_height + clearance)
     steps = 0
     if via is not None:
-        steps += arm.move_to_joints(via.joints, steps=VIA_STEPS).steps
-    motion = arm.move_to_joints(final.joints, steps=FINAL_STEPS)
+        steps += arm.move_to_joints(via.joints,
+                                    steps=paced_steps(arm.joint_positions(), via.joints, VIA_STEPS, joint_speed)).steps
+    motion = arm.move_to_joints(final.joints,
+                                steps=paced_steps(arm.joint_positions(), final.joints, FINAL_STEPS, joint_speed))
     steps += motion.steps
     tip = arm.fingertip_position()
     horizontal = float(np.hypot(tip[0] - position[0], tip[1] - position[1]))
