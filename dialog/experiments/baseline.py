@@ -67,8 +67,8 @@ def check_against_baseline(suite: Suite, summaries: list[CheckpointSummary], pat
     failures = []
     for s in summaries:
         stored = bands.get(s.condition, {}).get(s.strategy)
-        if stored is None and s.strategy in suite.weights:
-            continue  # a --weights strategy: the user's own, no baseline to hold it to
+        if stored is None and (s.strategy in suite.weights or s.strategy.startswith("rl:")):
+            continue  # a --weights strategy or a trained policy: the user's own, no baseline to hold it to
         if stored is None:
             failures.append(f"{s.strategy}/{s.condition}: not in the baseline")
             continue

@@ -15,6 +15,14 @@ from dialog.experiments.episodes import EpisodeSpec, run_episode
 from dialog.experiments.suite import Suite
 from learning.actions import DEFAULT_COSTS
 from learning.errors import SetupError
+from learning.strategies.rl_questioner import PREFIX as RL_PREFIX
+
+
+def file_label(strategy: str) -> str:
+    """A strategy's name as a file name: ``rl:path/to/questioner.toml`` becomes ``rl-questioner``."""
+    if strategy.startswith(RL_PREFIX):
+        return f"rl-{Path(strategy[len(RL_PREFIX):]).stem}"
+    return strategy
 
 
 def episode_specs(suite: Suite, results_dir: Path) -> list[EpisodeSpec]:
@@ -25,7 +33,8 @@ def episode_specs(suite: Suite, results_dir: Path) -> list[EpisodeSpec]:
         for strategy in suite.strategies:
             for dataset in range(suite.datasets):
                 for seed in suite.seeds:
-                    transcript = results_dir / "transcripts" / condition.name / f"{strategy}-d{dataset}-s{seed}.jsonl"
+                    transcript = (results_dir / "transcripts" / condition.name
+                                  / f"{file_label(strategy)}-d{dataset}-s{seed}.jsonl")
                     specs.append(EpisodeSpec(
                         suite=suite.name, task=suite.task, kitchen=suite.kitchen, strategy=strategy,
                         condition=condition, dataset=dataset, seed=seed, costs=costs,

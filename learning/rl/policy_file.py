@@ -85,6 +85,11 @@ class QuestionerPolicy:
         return int(np.argmax(logits))
 
 
+def policy_digest(path: str | Path) -> str:
+    """SHA-256 of a policy's TOML file (which records its weights' SHA-256, so this names both)."""
+    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+
+
 def save_policy(path: str | Path, policy: QuestionerPolicy, comment: str = "") -> Path:
     """Write ``path`` (.toml) and its weights (the same name, .npz), each written beside and renamed into place."""
     path = Path(path)

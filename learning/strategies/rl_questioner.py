@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from learning.actions import Decision
-from learning.rl.policy_file import QuestionerPolicy, load_policy
+from learning.rl.policy_file import QuestionerPolicy, load_policy, policy_digest
 from learning.state import LearningState
 from learning.strategies.base import Strategy
 from learning.whatif import make_engine
@@ -26,12 +26,20 @@ class RLQuestionerStrategy(Strategy):
     """The deterministic action of a trained questioner policy; ``name`` is how reports show it."""
 
     def __init__(self, policy: QuestionerPolicy | str | Path, name: str | None = None, engine="fast"):
+        self.file: str | None = None
         if not isinstance(policy, QuestionerPolicy):
             name = name or f"{PREFIX}{policy}"
+            self.file = str(Path(policy).resolve())
             policy = load_policy(policy)
         self.policy = policy
         self.name = name or "rl"
         self.engine = make_engine(engine)
+
+    def header_fields(self) -> dict:
+        """What a transcript header records of the policy: its file and SHA-256 (a resume checks they still match)."""
+        if self.file is None:
+            return {}
+        return {"policy": {"file": self.file, "sha256": policy_digest(self.file)}}
 
     def choose(self, state: LearningState, rng: np.random.Generator) -> Decision:
         observation = self.policy.layout.encode(state, self.engine)
