@@ -1,0 +1,146 @@
+"""Speed of teachbot/Questioning-v0 and of the trained questioner's decisions, each against a reference in the same run.
+
+1. Environment steps per second on cached data (the chapter-7 training
+   condition: prepare-lunch, 12 objects a scene, budget 15, 30 turns), a masked
+   random agent, with the what-if observation (every slot's E[phi(s') | a]) and
+   without it, against the turns per second of the plain dialog loop that
+   ``teachbot regress`` runs (the same manager, teacher and data): with the
+   what-if observation against DT-task choosing (it runs the same what-if
+   engine every turn), without it against U-sampling: the ratio is the price
+   of the Gymnasium wrapper.
+2. Decision time: the RL questioner's ``choose`` (observation + forward pass)
+   against DT-task's ``choose`` (what-if engine + eq. 7.1), on the very same
+   learning states, taken from the environment's episodes.
+
+BLAS runs on one thread. Wall-clock medians; the load average is reported.
+
+    python scripts/bench_gym.py --json        # last line: one JSON object
+"""
+
+from __future__ import annotations
+
+import argparse
+import copy
+import json
+import os
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+SHIPPED = Path(__file__).resolve().parents[1] / "learning" / "rl" / "policies" / "questioner-ch7-training.toml"
+
+
+def _parse(argv):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--episodes", type=int, default=6, help="episodes per measurement (default 6)")
+    parser.add_argument("--policy", type=Path, default=SHIPPED, help="questioner policy (default: the shipped one)")
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--json", action="store_true", help="end with one JSON line")
+    args = parser.parse_args(argv)
+    if args.episodes < 1:
+        parser.error(f"--episodes must be at least 1, got {args.episodes}")
+    return args
+
+
+def env_steps_per_second(whatif: bool, episodes: int, seed: int) -> float:
+    from dialog.gym_env import QuestioningEnv
+
+    env = QuestioningEnv(whatif=whatif)
+    rng = np.random.default_rng(seed)
+    steps, started = 0, time.perf_counter()
+    for episode in range(episodes):
+        _, info = env.reset(seed=seed + episode)
+        done = False
+        while not done:
+            _, _, done, _, info = env.step(int(rng.choice(np.flatnonzero(info["action_mask"]))))
+            steps += 1
+    return steps / (time.perf_counter() - started)
+
+
+def loop_turns_per_second(episodes: int, seed: int, strategy: str) -> float:
+    """The reference: ``regress``'s episode (dialog.experiments.episodes.run_episode) in the same condition."""
+    import tempfile
+    from dataclasses import replace
+
+    from dialog.experiments.episodes import run_episode
+    from dialog.experiments.irl_rollouts import training_condition
+
+    condition = training_condition()
+    turns, started = 0, time.perf_counter()
+    with tempfile.TemporaryDirectory() as scratch:
+        for episode in range(episodes):
+            spec = replace(condition.spec(seed + episode), strategy=strategy,
+                           transcript=str(Path(scratch) / f"e{episode}.jsonl"))
+            turns += len(run_episode(spec)["series"]["turn"])
+    return turns / (time.perf_counter() - started)
+
+
+def decision_times(policy_path: Path, episodes: int, seed: int) -> dict:
+    from dialog.gym_env import QuestioningEnv
+    from learning.rl.observation import ObservationLayout
+    from learning.rl.policy_file import QuestionerPolicy, load_policy
+    from learning.strategies import make_strategy
+    from learning.strategies.rl_questioner import RLQuestionerStrategy
+
+    env = QuestioningEnv()
+    if policy_path.is_file():
+        policy, source = load_policy(policy_path), str(policy_path)
+    else:  # the time does not depend on the weights: a policy of the trained one's shape
+        layout: ObservationLayout = env.layout
+        rng = np.random.default_rng(seed)
+        sizes = [layout.size, 64, 64, layout.n_actions]
+        policy = QuestionerPolicy(layout, tuple(rng.normal(0, 0.1, (sizes[k + 1], sizes[k])) for k in range(3)),
+                                  tuple(np.zeros(sizes[k + 1]) for k in range(3)))
+        source = "random weights of the trained policy's shape (no policy file)"
+    rl, dt = RLQuestionerStrategy(policy), make_strategy("dt-task")
+    rng = np.random.default_rng(seed)
+    times: dict[str, list[float]] = {"rl": [], "dt-task": []}
+    for episode in range(episodes):
+        _, info = env.reset(seed=10_000 + seed + episode)
+        done = False
+        while not done:
+            for name, strategy in (("rl", rl), ("dt-task", dt)):
+                state = copy.deepcopy(env.manager.state)  # each starts cold: nothing computed by the other
+                state.cache.clear()
+                started = time.perf_counter()
+                strategy.choose(state, rng)
+                times[name].append(time.perf_counter() - started)
+            _, _, done, _, info = env.step(int(rng.choice(np.flatnonzero(info["action_mask"]))))
+    rl_ms, dt_ms = (1000 * float(np.median(times[k])) for k in ("rl", "dt-task"))
+    return {"policy": source, "decisions": len(times["rl"]), "rl_ms": round(rl_ms, 3), "dt_task_ms": round(dt_ms, 3),
+            "rl_over_dt_task": round(rl_ms / dt_ms, 3)}
+
+
+def main(argv=None) -> int:
+    args = _parse(sys.argv[1:] if argv is None else argv)
+    from dialog.threads import one_blas_thread
+
+    load_before = os.getloadavg()[0]
+    with one_blas_thread():
+        loop = loop_turns_per_second(args.episodes, args.seed, "active")
+        loop_dt = loop_turns_per_second(args.episodes, args.seed, "dt-task")
+        with_whatif = env_steps_per_second(True, args.episodes, args.seed)
+        without = env_steps_per_second(False, args.episodes, args.seed)
+        decisions = decision_times(args.policy, args.episodes, args.seed)
+    result = {"episodes": args.episodes, "loop_turns_per_s": round(loop, 2),
+              "loop_dt_task_turns_per_s": round(loop_dt, 2),
+              "env_steps_per_s_whatif": round(with_whatif, 2), "env_steps_per_s_no_whatif": round(without, 2),
+              "env_whatif_over_dt_task_loop": round(with_whatif / loop_dt, 3),
+              "env_no_whatif_over_loop": round(without / loop, 3),
+              **decisions, "load_average": [round(load_before, 2), round(os.getloadavg()[0], 2)]}
+    print(f"dialog loop (regress): U-sampling {loop:.1f} turns/s, DT-task {loop_dt:.1f} turns/s")
+    print(f"Questioning-v0 with the what-if observation: {with_whatif:.1f} steps/s ({with_whatif / loop_dt:.2f} x the "
+          "DT-task loop, which computes the same what-if)")
+    print(f"Questioning-v0 without it: {without:.1f} steps/s ({without / loop:.2f} x the U-sampling loop)")
+    print(f"decision time over {decisions['decisions']} states: RL questioner {decisions['rl_ms']:.2f} ms, DT-task "
+          f"{decisions['dt_task_ms']:.2f} ms (ratio {decisions['rl_over_dt_task']:.2f}); policy {decisions['policy']}")
+    print(f"load average {result['load_average'][0]} -> {result['load_average'][1]}")
+    if args.json:
+        print(json.dumps(result))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
