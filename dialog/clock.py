@@ -34,11 +34,16 @@ class VirtualClock:
 
 
 class WallClock:
-    """Real time since construction (plus ``start``); ``sleep`` really waits."""
+    """Real time since construction (plus ``start``); ``sleep`` really waits.
 
-    def __init__(self, start: float = 0.0, monotonic=time.monotonic, sleeper=time.sleep):
+    ``counts_simulated``: ``advance`` adds simulated time (the arm's motion, embodied costs) on top of the real
+    time, so that a person's session with embodied costs counts both."""
+
+    def __init__(self, start: float = 0.0, monotonic=time.monotonic, sleeper=time.sleep,
+                 counts_simulated: bool = False):
         self._monotonic, self._sleeper = monotonic, sleeper
         self._origin = monotonic() - float(start)
+        self.counts_simulated = counts_simulated
 
     def now(self) -> float:
         return self._monotonic() - self._origin
@@ -48,7 +53,9 @@ class WallClock:
             self._sleeper(seconds)
 
     def advance(self, seconds: float) -> None:
-        """Simulated time (the arm's motion) does not move the wall clock."""
+        """Simulated time (the arm's motion) does not move the wall clock, unless it ``counts_simulated``."""
+        if self.counts_simulated and seconds > 0:
+            self._origin -= float(seconds)
 
     def sleep_until(self, moment: float) -> None:
         self.sleep(moment - self.now())

@@ -22,6 +22,7 @@ import numpy as np
 from dialog import records as checks
 from dialog.clock import VirtualClock
 from dialog.conversation import Outcome, converse
+from dialog.embodied import load_embodied_costs
 from dialog.environment import DEFAULT_TEST_SCENES, Environment, HasTestScenes, SupportsFetch
 from dialog.parsing import AnswerParser
 from dialog.questions import Prompt, Questioner, acknowledgement, question_text
@@ -51,6 +52,10 @@ class EpisodeConfig:
     realtime: seconds per turn (None: turn-based); a late answer counts as none.
     pictures: folder for numbered scene pictures (None: no pictures).
     fetch_from_pantry: fetch an example the teacher says is absent, where the task allows.
+    seconds: embodied costs (thesis §8.2.2): the time allocation in seconds (None: in turns); a turn lasts what
+    it takes (pointing, fetching, saying the question, the answer; a quiet turn ``dialog.embodied``'s seconds),
+    the scene changes every ``change_every`` nominal turns of seconds (as in real-time mode), and the episode
+    ends once the seconds are used up or after ``turns`` turns (the cap).
     """
 
     turns: int = DEFAULTS.turns
@@ -61,9 +66,10 @@ class EpisodeConfig:
     realtime: float | None = DEFAULTS.realtime
     pictures: str | None = None
     fetch_from_pantry: bool = DEFAULTS.fetch_from_pantry
+    seconds: float | None = None
 
     def __post_init__(self):
-        check_allocation(self.turns, self.budget, self.change_every, self.realtime)
+        check_allocation(self.turns, self.budget, self.change_every, self.realtime, seconds=self.seconds)
 
 
 @dataclass
@@ -120,6 +126,8 @@ class DialogManager:
         self._test = None
         self._undo_stack: list[tuple] = []
         self.questioner = Questioner(environment, self.state, config.pictures)
+        self.embodied = load_embodied_costs() if config.seconds is not None else None  # dialog/embodied.py
+        self._pointing: tuple[int, np.ndarray] | None = None  # (scene id, each object's expected pointing seconds)
 
     # -- episode ------------------------------------------------------------------
     def header(self) -> dict:
@@ -127,7 +135,10 @@ class DialogManager:
         return {"seed": config.seed, "turns": config.turns, "budget": config.budget,
                 "change_every": config.change_every, "realtime": config.realtime, "costs": dict(config.costs),
                 "fetch_from_pantry": config.fetch_from_pantry, "strategy": self.strategy.name,
-                "concepts": list(self.env.concepts), "features": len(self.env.feature_names), **self.session}
+                "concepts": list(self.env.concepts), "features": len(self.env.feature_names),
+                **getattr(self.strategy, "header_fields", dict)(), **self.session,
+                **({} if self.embodied is None else {"seconds": config.seconds,
+                                                     "embodied_costs": self.embodied.record()})}
 
     def begin(self) -> None:
         """Draw the held-out test set and write the session header (once)."""
@@ -144,6 +155,8 @@ class DialogManager:
         while self.turn < self.config.turns and not self.quit:
             if self.turn < len(replay):
                 self.replay_turn(replay[self.turn])
+            elif self.out_of_time():
+                break
             else:
                 self.play_turn()
         return self.finish(time.perf_counter() - started)
@@ -161,6 +174,10 @@ class DialogManager:
         )
 
     # -- the clock and the world ---------------------------------------------------
+    def out_of_time(self) -> bool:
+        """With embodied costs: the seconds allocation is used up (the turns cap is checked by the loop)."""
+        return self.embodied is not None and self.clock.now() >= self.config.seconds
+
     def begin_turn(self) -> float:
         """Start the next turn (the scene changes when it is due) and return its start time; then ``realise``
         one action. ``play_turn`` does both; a caller that chooses the action itself after seeing the turn's
@@ -174,6 +191,9 @@ class DialogManager:
             self.clock.sleep_until(self.turn * config.realtime)
             start = self.clock.now()
             epoch = int(start // (config.change_every * config.realtime))
+        elif self.embodied is not None:  # embodied costs: the world changes with time, not with the turn count
+            start = self.clock.now()
+            epoch = int(start // self.embodied.scene_seconds(config.change_every))
         else:
             start = self.clock.now()
             epoch = self.turn // config.change_every
@@ -186,7 +206,16 @@ class DialogManager:
             self.state.observe_scene(self.scene.scene_id, self.scene.X)
             self._notify("on_scene", self.scene)
             self.say(f"-- turn {self.turn + 1}: the robot looks at a new scene of {self.scene.n_objects} objects")
+        if self.embodied is not None:
+            self.state.set_seconds_clock(self.embodied.clock(self.config.seconds, start, self.pointing_seconds(),
+                                                             self.config.fetch_from_pantry and self.can_fetch))
         return start
+
+    def pointing_seconds(self) -> np.ndarray:
+        """Each scene object's expected pointing seconds (embodied costs), from its measured distance and bearing."""
+        if self._pointing is None or self._pointing[0] != self.scene.scene_id:
+            self._pointing = (self.scene.scene_id, self.embodied.pointing_seconds(self.scene.X, self.scene.feature_names))
+        return self._pointing[1]
 
     def admissible(self, action: Action) -> tuple[Action, str]:
         """The action itself if it may be taken now, else no query and the reason."""
@@ -224,11 +253,19 @@ class DialogManager:
         message = ""
         if action.kind == "none":
             outcome = Outcome("none")
+            if self.embodied is not None:
+                self.clock.advance(self.embodied.quiet)
             self.say(f"Turn {number:>3} · Robot stays quiet. ({explanation})")
         else:
             if action.kind == "label":
                 record["gesture"] = self.env.point_at(scene, action.object_index)
+                if self.embodied is not None and "sim_seconds" not in record["gesture"]:  # no arm: the model's time
+                    modelled = round(float(self.pointing_seconds()[action.object_index]), 3)
+                    record["gesture"] = {**record["gesture"], "model_seconds": modelled}
+                    self.clock.advance(modelled)
                 self.clock.advance(record["gesture"].get("sim_seconds", 0.0))
+            if self.embodied is not None:  # saying the question
+                self.clock.advance(self.embodied.speaking[action.kind])
             prompt = self.prompt_for(action, explanation, number, start)
             record["question"] = prompt.text
             if prompt.picture:
@@ -269,6 +306,8 @@ class DialogManager:
             "ended": round(self.clock.now(), 3),
             "accuracy": round(accuracy(self.state.predict(test_X), test_y), 6),
         })
+        if self.embodied is not None:  # how long the turn took
+            record["seconds"] = round(record["ended"] - record["time"], 3)
         self.transcript.write(record)
         self.turn += 1
         self._notify("on_turn", record, self.scene)

@@ -91,6 +91,9 @@ def check_header(header: dict, path) -> None:
     realtime = header.get("realtime")
     if realtime is not None and not (_is_number(realtime) and realtime > 0):
         raise refuse("realtime", "null or a positive number of seconds per turn")
+    seconds = header.get("seconds")
+    if seconds is not None and not (_is_number(seconds) and seconds > 0 and realtime is None):
+        raise refuse("seconds", "null or a positive number of seconds (embodied costs; not with realtime)")
     if not isinstance(header.get("fetch_from_pantry", True), bool):
         raise refuse("fetch_from_pantry", "true or false")
     costs = header.get("costs", DEFAULT_COSTS)
@@ -154,6 +157,8 @@ def check_compatible(header: dict, environment, path) -> None:
 def make_clock(settings: SessionSettings, start: float = 0.0):
     """Wall time for a person or a real-time session; virtual (deterministic) time for scripted runs."""
     real = settings.teacher["kind"] == "terminal" or settings.realtime is not None
+    if real and settings.seconds is not None:  # embodied costs: a person's real time plus the arm's motion
+        return WallClock(start, counts_simulated=True)
     return WallClock(start) if real else VirtualClock(start)
 
 
@@ -161,8 +166,13 @@ def session_teacher(settings: SessionSettings, rngs, clock, input_stream=None, o
     """The session's teacher, from its recorded kind and options (``dialog.teachers.make_teacher``)."""
     kind = settings.teacher["kind"]
     options = {key: settings.teacher[key] for key in SCRIPTED_OPTIONS if key in settings.teacher and kind == "scripted"}
+    delays = None
+    if settings.seconds is not None and kind == "scripted":  # embodied costs: the per-kind answer times
+        from dialog.embodied import load_embodied_costs
+
+        delays = load_embodied_costs().answer
     return make_teacher(kind, rng=rngs["teacher"], clock=clock, transcript=settings.teacher.get("transcript"),
-                        input_stream=input_stream, output_stream=output_stream, **options)
+                        input_stream=input_stream, output_stream=output_stream, answer_delays=delays, **options)
 
 
 def open_session(settings: SessionSettings, environment, transcript_path: str | Path, *, resume: bool = False,

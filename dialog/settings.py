@@ -19,8 +19,9 @@ from learning.errors import SettingsError
 __all__ = ["DEFAULTS", "EpisodeSettings", "check_allocation", "check_costs"]
 
 
-def check_allocation(turns, budget, change_every, realtime=None, seed=0) -> None:
-    """T turns, budget B, a change every r turns, seconds per turn (None: turn-based) and the seed, or SettingsError."""
+def check_allocation(turns, budget, change_every, realtime=None, seed=0, seconds=None) -> None:
+    """T turns, budget B, a change every r turns, seconds per turn (None: turn-based), the seed and an embodied
+    allocation in seconds (None: time in turns), or SettingsError."""
     if not _is_int(turns) or turns < 1:
         raise SettingsError(f"turns must be at least 1, got {turns}")
     if not (isinstance(budget, Real) and not isinstance(budget, bool) and budget >= 0):
@@ -31,6 +32,11 @@ def check_allocation(turns, budget, change_every, realtime=None, seed=0) -> None
         raise SettingsError(f"realtime must be a positive number of seconds per turn, got {realtime}")
     if not _is_int(seed) or seed < 0:
         raise SettingsError(f"seed must be a whole number of 0 or more, got {seed}")
+    if seconds is not None and not (_is_number(seconds) and seconds > 0):
+        raise SettingsError(f"the time allocation in seconds must be a positive number, got {seconds}")
+    if seconds is not None and realtime is not None:
+        raise SettingsError("embodied costs (a time allocation in seconds) and real-time turns don't go together; "
+                            "choose one")
 
 
 def check_costs(costs) -> None:
@@ -56,12 +62,13 @@ class EpisodeSettings:
     fetch_from_pantry: bool = True
     costs: dict = field(default_factory=lambda: dict(DEFAULT_COSTS))
     weights: dict | None = None  # DT with a user's weights: {"file": path, "values": {feature: weight}} (--weights)
+    seconds: float | None = None  # embodied costs (thesis §8.2.2): the time allocation in seconds; turns is the cap
 
     def __post_init__(self):
         for name, value in (("task", self.task), ("kitchen", self.kitchen), ("strategy", self.strategy)):
             if not isinstance(value, str) or not value:
                 raise SettingsError(f"{name} must be a name, got {value!r}")
-        check_allocation(self.turns, self.budget, self.change_every, self.realtime, self.seed)
+        check_allocation(self.turns, self.budget, self.change_every, self.realtime, self.seed, self.seconds)
         if not isinstance(self.fetch_from_pantry, bool):
             raise SettingsError(f"fetch_from_pantry must be true or false, got {self.fetch_from_pantry!r}")
         check_costs(self.costs)
@@ -73,10 +80,11 @@ class EpisodeSettings:
     def build_strategy(self):
         """The episode's strategy: the named one, or DT with the recorded user weights (shown as ``strategy``)."""
         from dialog.user_weights import weights_from_record
-        from learning.strategies import make_strategy
 
         if self.weights is None:
-            return make_strategy(self.strategy)
+            from dialog.embodied import make_episode_strategy
+
+            return make_episode_strategy(self.strategy)
         return weights_from_record(self.weights).strategy(self.strategy)
 
     def config(self, pictures: str | None = None):
@@ -85,7 +93,7 @@ class EpisodeSettings:
 
         return EpisodeConfig(turns=self.turns, budget=self.budget, change_every=self.change_every, seed=self.seed,
                              costs=dict(self.costs), realtime=self.realtime, pictures=pictures,
-                             fetch_from_pantry=self.fetch_from_pantry)
+                             fetch_from_pantry=self.fetch_from_pantry, seconds=self.seconds)
 
 
 def _is_int(value) -> bool:

@@ -121,11 +121,13 @@ class ScriptedTeacher:
     of answering "I don't know". feature_quality q in [0, 1]: each relevant
     feature is chosen with probability q, and about (1 - q) x as many irrelevant
     ones are added. answer_delay: mean seconds per answer (gamma distributed),
-    spent on the injected clock.
+    spent on the injected clock; answer_delays: a mean per query kind instead
+    (label, demo, feature), as embodied costs set them (dialog/embodied.py).
     """
 
     def __init__(self, rng: np.random.Generator, mislabel_rate: float = 0.0, dont_know_rate: float = 0.0,
-                 feature_quality: float = 1.0, answer_delay: float = 0.0, clock=None):
+                 feature_quality: float = 1.0, answer_delay: float = 0.0, clock=None,
+                 answer_delays: dict | None = None):
         for name, value in (("mislabel rate", mislabel_rate), ("don't-know rate", dont_know_rate),
                             ("feature quality", feature_quality)):
             if not 0.0 <= float(value) <= 1.0:
@@ -136,6 +138,7 @@ class ScriptedTeacher:
         self.mislabel_rate, self.dont_know_rate = float(mislabel_rate), float(dont_know_rate)
         self.feature_quality, self.answer_delay = float(feature_quality), float(answer_delay)
         self.clock = clock or VirtualClock()
+        self.answer_delays = None if answer_delays is None else {k: float(v) for k, v in answer_delays.items()}
         self.heard: list[str] = []
         self.mislabels = 0
 
@@ -164,7 +167,9 @@ class ScriptedTeacher:
         rng = self.rng
         dont_know = rng.random() < self.dont_know_rate
         wrong = rng.random() < self.mislabel_rate
-        delay = float(rng.gamma(DELAY_SHAPE, self.answer_delay / DELAY_SHAPE)) if self.answer_delay > 0 else 0.0
+        mean = self.answer_delay if self.answer_delays is None else \
+            self.answer_delays.get(prompt.action.kind, self.answer_delay)
+        delay = float(rng.gamma(DELAY_SHAPE, mean / DELAY_SHAPE)) if mean > 0 else 0.0
         if dont_know:
             return "I don't know", delay
         truth = prompt.scene.truth
@@ -201,10 +206,11 @@ class ScriptedTeacher:
 
 
 class OracleTeacher(ScriptedTeacher):
-    """A perfect scripted teacher: always right, never unsure, answers at once."""
+    """A perfect scripted teacher: always right, never unsure, answers at once (or, with embodied costs, after
+    its ``answer_delays``)."""
 
-    def __init__(self, rng: np.random.Generator, clock=None):
-        super().__init__(rng, clock=clock)
+    def __init__(self, rng: np.random.Generator, clock=None, answer_delays: dict | None = None):
+        super().__init__(rng, clock=clock, answer_delays=answer_delays)
 
 
 class ReplayTeacher:
@@ -234,12 +240,13 @@ SCRIPTED_OPTIONS = ("mislabel_rate", "dont_know_rate", "feature_quality", "answe
 
 
 def make_teacher(kind: str, *, rng: np.random.Generator | None = None, clock=None, transcript=None,
-                 input_stream=None, output_stream=None, **options) -> Teacher:
+                 input_stream=None, output_stream=None, answer_delays: dict | None = None, **options) -> Teacher:
     """The one teacher factory, for teach sessions, expert episodes and suites.
 
     ``terminal``: a person (``input_stream``/``output_stream``, the terminal by default); ``scripted``: an
     oracle with ``SCRIPTED_OPTIONS`` drawn from ``rng``; ``oracle``: a perfect one; ``replay``: the lines of the
     ``transcript`` file. An unknown kind or option is a :class:`SettingsError` naming what is accepted.
+    ``answer_delays`` (embodied costs): a scripted or oracle teacher's mean answer seconds per query kind.
     """
     if kind not in TEACHER_KINDS:
         raise SettingsError(f"teacher '{kind}' is not one of {', '.join(TEACHER_KINDS)}")
@@ -261,5 +268,6 @@ def make_teacher(kind: str, *, rng: np.random.Generator | None = None, clock=Non
     if rng is None:
         raise TypeError(f"a {kind} teacher needs its random generator (rng=)")
     if kind == "oracle":
-        return OracleTeacher(rng, clock=clock)
-    return ScriptedTeacher(rng, clock=clock, **{name: float(value) for name, value in options.items()})
+        return OracleTeacher(rng, clock=clock, answer_delays=answer_delays)
+    return ScriptedTeacher(rng, clock=clock, answer_delays=answer_delays,
+                           **{name: float(value) for name, value in options.items()})

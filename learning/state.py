@@ -55,6 +55,7 @@ class LearningState:
         self._training_version = 0  # bumps whenever the training set changes
         self.cache: dict = {}  # what-if engines memoise (version, value) entries here; not learning state
         self._scene_P: np.ndarray | None = None
+        self._seconds = None  # embodied costs: a learning.decision.embodied.SecondsClock (None: time in turns)
         self._refit()
 
     # -- changing the state ---------------------------------------------------------
@@ -141,6 +142,14 @@ class LearningState:
             subsets = {c: subset for c in self.concepts}
         added = tuple(Example(read_only(x), c, "label", -1) for x, c in zip(X, concepts))
         self._commit(scaler=scaler, examples=self._examples + added, subsets=subsets)
+
+    def set_seconds_clock(self, clock) -> None:
+        """Embodied costs (thesis §8.2.2): the allocation in seconds, the seconds used and what each action is
+        expected to take (a :class:`~learning.decision.embodied.SecondsClock`), set by the caller each turn;
+        None: time in turns."""
+        self._seconds = clock
+
+    seconds_clock = property(lambda self: self._seconds, doc="The embodied-cost clock, or None (time in turns).")
 
     def place_progress(self, **fields) -> None:
         """Put the budget and clock part-way through an episode (``spent``, ``turn``, ``history``,

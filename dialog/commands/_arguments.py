@@ -164,3 +164,57 @@ def add_episode_options(parser: argparse.ArgumentParser, strategies, default_str
                         help=f"questioning strategy (default {default_strategy})")
     add_task_option(parser, defaults.task)
     add_kitchen_option(parser, defaults.kitchen)
+
+
+TIME_FORMS = "a number of turns (e.g. --time 40) or of seconds ending in s (e.g. --time 600s)"
+
+
+def time_allocation(text: str) -> tuple[str, float]:
+    """``--time``: ``40`` (turns, a whole number >= 1) or ``600s`` (seconds, > 0, with --embodied-costs)."""
+    raw = text.strip()
+    unit = "seconds" if raw.lower().endswith("s") else "turns"
+    number = raw[:-1].strip() if unit == "seconds" else raw
+    try:
+        value = float(number) if unit == "seconds" else int(number)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"'{text}' is not {TIME_FORMS}") from None
+    if unit == "seconds" and not (value > 0 and value != float("inf")):
+        raise argparse.ArgumentTypeError(f"'{text}' is not {TIME_FORMS}: seconds must be a positive number")
+    if unit == "turns" and value < 1:
+        raise argparse.ArgumentTypeError(f"'{text}' is not {TIME_FORMS}: turns must be at least 1")
+    return unit, value
+
+
+def add_time_options(parser: argparse.ArgumentParser) -> None:
+    """``--time`` (turns or seconds) and ``--embodied-costs`` (thesis §8.2.2)."""
+    parser.add_argument("--time", type=time_allocation, default=None, metavar="T",
+                        help=f"time allocation: {TIME_FORMS}; seconds need --embodied-costs (default: --turns)")
+    parser.add_argument("--embodied-costs", action="store_true",
+                        help="a turn lasts what it takes in the simulation (the arm's motion, a pantry fetch, saying "
+                             "the question, the teacher's answer); the time allocation is in seconds (default from "
+                             "dialog/data/embodied-costs.toml) and DT weighs each question by its expected seconds")
+
+
+def resolve_time(args, defaults: EpisodeSettings = DEFAULTS) -> tuple[int, float | None]:
+    """(turns, seconds) from --turns, --time and --embodied-costs; a contradiction is one SettingsError line.
+
+    Without --embodied-costs: turns only (``--time N`` is ``--turns N``). With it: the seconds of ``--time Ns``
+    (or the data file's default allocation) and a turns cap: ``--time N``/``--turns N`` if given, else as many
+    quiet turns as the seconds hold."""
+    from dialog.embodied import default_allocation, load_embodied_costs
+    from learning.errors import SettingsError
+
+    unit, value = args.time if args.time is not None else (None, None)
+    turns_given = args.turns != defaults.turns
+    if unit == "turns" and turns_given and args.turns != value:
+        raise SettingsError(f"--time {value} and --turns {args.turns} both give the time allocation; give one")
+    turns = int(value) if unit == "turns" else args.turns
+    if not args.embodied_costs:
+        if unit == "seconds":
+            raise SettingsError(f"--time {value:g}s: a time in seconds needs --embodied-costs (without it the time "
+                                f"allocation is in turns, e.g. --time {turns})")
+        return turns, None
+    seconds = float(value) if unit == "seconds" else default_allocation()
+    if unit != "turns" and not turns_given:
+        turns = max(1, int(-(-seconds // load_embodied_costs().quiet)))
+    return turns, seconds

@@ -26,6 +26,8 @@ SESSION_OPTIONS = {
     "--answer-delay": ("answer_delay", lambda s: s.teacher.get("answer_delay", 0.0)),
     "--no-fetch": ("no_fetch", lambda s: not s.fetch_from_pantry),
     "--weights": ("weights", lambda s: None if s.weights is None else s.weights["file"]),
+    "--embodied-costs": ("embodied_costs", lambda s: s.seconds is not None),
+    "--time": ("time", lambda s: ("turns", s.turns) if s.seconds is None else ("seconds", s.seconds)),
 }
 
 

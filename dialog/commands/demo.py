@@ -7,11 +7,13 @@ import json
 from dataclasses import asdict
 from pathlib import Path
 
-from dialog.commands._arguments import add_episode_options
+from dialog.clock import VirtualClock
+from dialog.commands._arguments import add_episode_options, add_time_options, resolve_time
 from dialog.commands._summary import questions_in_words
 from dialog.commands._viewer import add_viewer_option, hold_viewer, viewer_observers
 from dialog.commands.teach import DEFAULT_STRATEGY
 from dialog.environment import SimulatedKitchen
+from dialog.experiments.runner import file_label
 from dialog.manager import DialogManager, episode_generators
 from dialog.settings import EpisodeSettings
 from dialog.teachers import OracleTeacher
@@ -31,6 +33,7 @@ def register(commands) -> None:
                     "kitchen; the summary gives the accuracy on held-out scenes, the budget spent and the questions "
                     "asked. Every turn goes to a transcript (JSON Lines); the same seed gives the same transcript.")
     add_episode_options(parser, STRATEGY_NAMES, DEFAULT_STRATEGY)
+    add_time_options(parser)
     parser.add_argument("--transcript", type=Path, default=None,
                         help="transcript path (default runs/demo-<strategy>-seed<seed>.jsonl)")
     add_weights_option(parser)
@@ -59,28 +62,35 @@ def refuse_foreign_transcript(path: Path, lock: TranscriptLock) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    turns, seconds = resolve_time(args)
     args.strategy, weights = weights_strategy(args.strategy, args.weights)  # --weights: DT shown as "dt"
     strategy = make_strategy(args.strategy) if weights is None else weights.strategy(WEIGHTS_STRATEGY_NAME)
     session = {"command": "demo"} if weights is None else {"command": "demo", "weights": weights.record()}
     if weights is not None:
         print(f"Strategy {WEIGHTS_STRATEGY_NAME}: DT with the weights in {weights.describe()}", flush=True)
     settings = EpisodeSettings(task=args.task, kitchen=args.kitchen, strategy=args.strategy, seed=args.seed,
-                               turns=args.turns, budget=args.budget, change_every=args.change_every)
+                               turns=turns, budget=args.budget, change_every=args.change_every, seconds=seconds)
     config = settings.config()
+    clock, delays, joint_speed = None, None, None
+    if seconds is not None:  # embodied costs: one clock for the arm, the turns and the teacher's answers
+        from dialog.embodied import load_embodied_costs
+
+        costs = load_embodied_costs()
+        clock, delays, joint_speed = VirtualClock(), costs.answer, costs.joint_speed
     rngs = episode_generators(args.seed)
-    transcript_path = args.transcript or Path("runs") / f"demo-{args.strategy}-seed{args.seed}.jsonl"
+    transcript_path = args.transcript or Path("runs") / f"demo-{file_label(args.strategy)}-seed{args.seed}.jsonl"
     lock = TranscriptLock(transcript_path)  # checked and held before the kitchen is built: one writer per file
     try:
         refuse_foreign_transcript(transcript_path, lock)
-        environment = SimulatedKitchen(task=args.task, kitchen=args.kitchen, seed=args.seed)
+        environment = SimulatedKitchen(task=args.task, kitchen=args.kitchen, seed=args.seed, joint_speed=joint_speed)
         try:
             with viewer_observers(args, environment.world) as observers:
                 with TranscriptWriter(transcript_path, lock=lock) as transcript:
-                    manager = DialogManager(environment, OracleTeacher(rngs["teacher"]),
-                                            strategy, config, transcript, rngs,
-                                            observers=observers, session=session)
+                    teacher = OracleTeacher(rngs["teacher"], clock=clock, answer_delays=delays)
+                    manager = DialogManager(environment, teacher, strategy, config, transcript, rngs,
+                                            observers=observers, session=session, clock=clock)
                     result = manager.run()
-                _print_summary(args, result, environment)
+                _print_summary(args, result, environment, manager)
                 hold_viewer(args, observers[0] if observers else None)
         finally:
             environment.close()
@@ -89,11 +99,13 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _print_summary(args: argparse.Namespace, result, environment) -> None:
+def _print_summary(args: argparse.Namespace, result, environment, manager) -> None:
+    used = "" if manager.embodied is None else \
+        f"time used {manager.clock.now():.0f} of {manager.config.seconds:g} s in {result.completed} turns; "
     print(f"\nAccuracy on {args.task} held-out scenes: {result.accuracy:.1%} "
           f"(chance {1 / len(environment.concepts):.0%}); budget spent {result.budget_spent:g} of {args.budget:g}; "
-          f"questions: {questions_in_words(result.queries)}; {result.seconds:.1f} s. Transcript: {result.transcript}",
-          flush=True)
+          f"questions: {questions_in_words(result.queries)}; {used}{result.seconds:.1f} s. "
+          f"Transcript: {result.transcript}", flush=True)
     if args.json:
         summary = {key: asdict(result)[key] for key in SUMMARY_KEYS}
         summary["queries"] = {kind: summary["queries"][kind] for kind in ("label", "demo", "feature", "none")}

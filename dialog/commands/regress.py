@@ -37,6 +37,10 @@ def register(commands) -> None:
     parser.add_argument("--weights", type=named_weights, action="append", default=None, metavar="NAME=FILE",
                         help="add a DT strategy called NAME with the weights in FILE (as teachbot learn-weights "
                              "writes them); repeatable")
+    parser.add_argument("--embodied-costs", action="store_true",
+                        help="every condition with embodied costs (a turn lasts what it takes; DT weighs questions by "
+                             "their expected seconds); a condition without 'seconds' gets the default allocation of "
+                             "dialog/data/embodied-costs.toml")
     parser.add_argument("--workers", type=positive_int, default=None, help="local worker processes (default: cores)")
     parser.add_argument("--ray", metavar="ADDRESS", default=None,
                         help="run the episodes on the Ray cluster at ADDRESS ('local' starts one here)")
@@ -47,11 +51,20 @@ def register(commands) -> None:
     parser.set_defaults(handler=run)
 
 
+def _embodied_seconds(args: argparse.Namespace) -> float | None:
+    if not args.embodied_costs:
+        return None
+    from dialog.embodied import default_allocation
+
+    return default_allocation()
+
+
 def run(args: argparse.Namespace) -> int:
     original = load_suite(args.suite, known_strategies=STRATEGY_NAMES).with_weights(read_named_weights(args.weights))
     kind = get_kind(original.kind)
     suite = kind.load(original.with_overrides(strategies=args.strategies, seeds=args.seeds, budget=args.budget,
-                                              datasets=args.datasets, data_seed=args.data_seed))
+                                              datasets=args.datasets, data_seed=args.data_seed,
+                                              embodied_seconds=_embodied_seconds(args)))
     if args.check:
         refuse_other_data_seed(suite)  # before anything runs
     out = args.results or Path("results") / suite.name

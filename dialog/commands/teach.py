@@ -7,11 +7,12 @@ import json
 import sys
 from pathlib import Path
 
-from dialog.commands._arguments import add_episode_options, budget, positive_seconds
+from dialog.commands._arguments import add_episode_options, add_time_options, budget, positive_seconds, resolve_time
 from dialog.commands._resume import check_resume_options
 from dialog.commands._summary import questions_in_words, session_time
 from dialog.commands._viewer import add_viewer_option, hold_viewer, start_viewer, stop_viewer
 from dialog.environment import SimulatedKitchen
+from dialog.experiments.runner import file_label
 from dialog.output_paths import check_writable
 from dialog.session import TEACHERS, SessionSettings, open_session
 from dialog.transcript import read_session
@@ -40,6 +41,7 @@ def register(commands) -> None:
         description="Answer the robot's questions at the terminal. Type 'help' at any question for the accepted "
                     "answers; 'quit' (or end of input) saves the session, which --resume continues.")
     add_episode_options(parser, STRATEGY_NAMES, DEFAULT_STRATEGY)
+    add_time_options(parser)
     parser.add_argument("--realtime", type=positive_seconds, default=None, metavar="SECONDS",
                         help="real-time mode: each turn lasts SECONDS; a later answer counts as none")
     parser.add_argument("--transcript", type=Path, default=None,
@@ -71,7 +73,7 @@ def register(commands) -> None:
 
 
 def _default_transcript(args, strategy: str) -> Path:
-    base = Path("runs") / f"teach-{args.task}-{strategy}-seed{args.seed}"
+    base = Path("runs") / f"teach-{args.task}-{file_label(strategy)}-seed{args.seed}"
     path, number = base.with_suffix(".jsonl"), 2
     while path.exists():
         path, number = Path(f"{base}-{number}.jsonl"), number + 1
@@ -88,9 +90,10 @@ def _settings(args) -> SessionSettings:
             raise SettingsError("--teacher replay needs --replay FILE (a transcript to answer from)")
         teacher["transcript"] = str(args.replay)
     strategy, weights = weights_strategy(args.strategy, args.weights)  # --weights: DT, shown as "dt"
+    turns, seconds = resolve_time(args)
     return SessionSettings(task=args.task, kitchen=args.kitchen, strategy=strategy, seed=args.seed,
-                           weights=None if weights is None else weights.record(),
-                           turns=args.turns, budget=args.budget, change_every=args.change_every,
+                           weights=None if weights is None else weights.record(), seconds=seconds,
+                           turns=turns, budget=args.budget, change_every=args.change_every,
                            realtime=args.realtime, fetch_from_pantry=not args.no_fetch, teacher=teacher)
 
 
@@ -144,8 +147,13 @@ def _teach(args, settings: SessionSettings, path: Path, lock: TranscriptLock, in
     person = settings.teacher["kind"] == "terminal"
     pictures = _picture_folder(args, path, person)
     out = output_stream or sys.stdout
+    joint_speed = None
+    if settings.seconds is not None:  # embodied costs: the arm's gestures paced by its joint-speed limit
+        from dialog.embodied import load_embodied_costs
+
+        joint_speed = load_embodied_costs().joint_speed
     environment = SimulatedKitchen(task=settings.task, kitchen=settings.kitchen, seed=settings.seed,
-                                   pictures=pictures is not None)
+                                   pictures=pictures is not None, joint_speed=joint_speed)
     viewer = None
     try:
         viewer = start_viewer(args, environment.world)
@@ -154,8 +162,10 @@ def _teach(args, settings: SessionSettings, path: Path, lock: TranscriptLock, in
                                         input_stream=input_stream, output_stream=out, say=None,
                                         observers=() if viewer is None else (viewer,), lock=lock)
         manager.say = _narrator(manager.teacher, out, person)
+        allocation = f"{settings.turns} turns" if settings.seconds is None else \
+            f"{settings.seconds:g} s with embodied costs (at most {settings.turns} turns)"
         intro = (f"Teaching '{settings.task}' ({', '.join(environment.concepts)}) in {settings.kitchen}: "
-                 f"{settings.turns} turns, budget {settings.budget:g}, strategy {settings.strategy}"
+                 f"{allocation}, budget {settings.budget:g}, strategy {settings.strategy}"
                  f"{'' if settings.weights is None else ' with the weights in ' + settings.weights['file']}. "
                  f"Transcript: {path}")
         if records:
@@ -163,8 +173,11 @@ def _teach(args, settings: SessionSettings, path: Path, lock: TranscriptLock, in
         if len(records) >= settings.turns:
             intro = (f"{path}: the session is already finished ({len(records)} of {settings.turns} turns); "
                      "nothing to resume")
+        elif records and settings.seconds is not None and records[-1].get("ended", 0.0) >= settings.seconds:
+            intro = (f"{path}: the session is already finished (its {settings.seconds:g} s are used up); "
+                     "nothing to resume")
         manager.say(intro)
-        if person and len(records) < settings.turns:
+        if person and len(records) < settings.turns and not manager.out_of_time():
             manager.say("Type 'help' at any question for what you can answer; 'quit' saves and stops.")
         try:
             result = manager.run(replay=records)

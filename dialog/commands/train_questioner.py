@@ -10,7 +10,14 @@ import argparse
 import json
 from pathlib import Path
 
-from dialog.commands._arguments import budget, positive_int, price, seed
+from dialog.commands._arguments import (
+    add_kitchen_option,
+    add_task_option,
+    budget,
+    positive_int,
+    price,
+    seed,
+)
 from dialog.output_paths import check_writable, writing
 from learning.errors import OutputPathError
 
@@ -31,7 +38,8 @@ def register(commands) -> None:
                         help="environments played in parallel worker processes (default: up to 2, one per core)")
     parser.add_argument("--seed", type=seed, default=0, help="seed of the episodes and of PPO (default 0)")
     condition = parser.add_argument_group("training condition (default: the ch7-training suite's)")
-    condition.add_argument("--task", default=None, help="task (default prepare-lunch)")
+    add_task_option(condition, None, "prepare-lunch")
+    add_kitchen_option(condition, None, "kitchen-1")
     condition.add_argument("--budget", type=budget, default=None, help="question budget (default 15)")
     condition.add_argument("--turns", type=positive_int, default=None, help="turns per episode (default 30)")
     condition.add_argument("--change-every", type=positive_int, default=None,
@@ -57,8 +65,9 @@ def run(args: argparse.Namespace) -> int:
     check_writable(args.out, "policy file")
     check_writable(args.out.with_suffix(".npz"), "policy weights")
     require_rl()
-    env = {"task": args.task, "budget": args.budget, "turns": args.turns, "change_every": args.change_every,
-           "data_seed": args.data_seed, "whatif": not args.no_whatif, "price": args.price}
+    env = {"task": args.task, "kitchen": args.kitchen, "budget": args.budget, "turns": args.turns,
+           "change_every": args.change_every, "data_seed": args.data_seed,
+           "whatif": not args.no_whatif, "price": args.price}
     config = TrainingConfig(steps=args.steps, envs=args.envs or default_envs(), seed=args.seed,
                             env={k: v for k, v in env.items() if v is not None})
     print(f"training a questioner with masked PPO for {config.steps} steps on {config.envs} environment(s), "

@@ -11,8 +11,9 @@ from dialog.experiments.suite import Finding, Suite
 from learning.significance import Comparison, accuracy_after_questions, mann_whitney, mean_and_standard_error
 
 
-def condition_checkpoints(suite: Suite, turns: int) -> tuple[int, ...]:
-    """The suite's checkpoints a condition of ``turns`` turns can reach (no more questions than turns either)."""
+def condition_checkpoints(suite: Suite, turns: float) -> tuple[int, ...]:
+    """The suite's checkpoints a condition of ``turns`` turns can reach (no more questions than turns either);
+    on the seconds axis, ``turns`` is the condition's seconds allocation."""
     return tuple(c for c in suite.checkpoints if c <= turns)
 
 
@@ -29,6 +30,9 @@ def checkpoint_values(result: dict, suite: Suite, checkpoints: tuple[int, ...] |
     if suite.axis == "questions":
         values = accuracy_after_questions(np.asarray(series["questions"]), accuracy, checkpoints)
         return np.where(np.isnan(values), accuracy[-1], values)
+    if suite.axis == "seconds":  # embodied costs: the accuracy of the last turn ended by each checkpoint
+        ended = np.asarray(series.get("seconds", series["turn"]), dtype=float)
+        return np.array([accuracy[ended <= t][-1] if np.any(ended <= t) else np.nan for t in checkpoints])
     turns = np.asarray(series["turn"])
     return np.array([accuracy[turns <= t][-1] if np.any(turns <= t) else np.nan for t in checkpoints])
 
@@ -56,8 +60,8 @@ def summarise(results: list[dict], suite: Suite) -> list[CheckpointSummary]:
     """One summary per (condition, strategy), at the checkpoints inside the condition's turns."""
     summaries = []
     for (condition, strategy), group in group_results(results).items():
-        turns = group[0]["spec"]["condition"].get("turns")
-        checkpoints = suite.checkpoints if turns is None else condition_checkpoints(suite, int(turns))
+        limit = group[0]["spec"]["condition"].get("seconds" if suite.axis == "seconds" else "turns")
+        checkpoints = suite.checkpoints if limit is None else condition_checkpoints(suite, limit)
         values = np.vstack([checkpoint_values(r, suite, checkpoints) for r in group]).reshape(len(group), -1)
         mean, error = mean_and_standard_error(values)
         summaries.append(CheckpointSummary(condition, strategy, checkpoints, mean, error, values))

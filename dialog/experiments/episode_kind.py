@@ -5,6 +5,7 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
+from dialog.embodied import strategy_names_with_variants
 from dialog.experiments.analysis import evaluate_findings, summarise
 from dialog.experiments.figures import save_figures
 from dialog.experiments.kinds import RunOptions, SuiteKind, SuiteRun, register_kind
@@ -21,7 +22,8 @@ class EpisodesKind(SuiteKind):
 
     def load(self, suite: Suite) -> Suite:
         where = suite.path or suite.name
-        unknown = [s for s in suite.strategies if s not in STRATEGY_NAMES and s not in suite.weights]
+        known = strategy_names_with_variants(STRATEGY_NAMES)  # NAME+turns: DT blind to embodied costs
+        unknown = [s for s in suite.strategies if s not in known and s not in suite.weights]
         if unknown:
             raise SuiteError(f"{where}: unknown strategies {unknown}; choose from: {', '.join(STRATEGY_NAMES)}")
         for finding in suite.findings:

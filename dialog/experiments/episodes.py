@@ -12,6 +12,8 @@ from pathlib import Path
 
 import numpy as np
 
+from dialog.clock import VirtualClock
+from dialog.embodied import load_embodied_costs, make_episode_strategy
 from dialog.experiments.pools import PoolEnvironment, load_pools
 from dialog.experiments.suite import Condition
 from dialog.manager import DialogManager, episode_generators
@@ -21,7 +23,7 @@ from dialog.threads import one_blas_thread
 from dialog.transcript import TranscriptWriter, read_transcript
 from dialog.user_weights import UserWeights
 from learning.errors import SettingsError
-from learning.strategies import Strategy, make_strategy
+from learning.strategies import Strategy
 
 SERIES = ("turn", "accuracy", "questions", "label", "demo", "feature", "spent")
 
@@ -56,20 +58,22 @@ class EpisodeSpec:
         condition = self.condition
         return EpisodeSettings(task=self.task, kitchen=self.kitchen, strategy=self.strategy, seed=self.episode_seed,
                                turns=condition.turns, budget=condition.budget, change_every=condition.change_every,
-                               costs=dict(self.costs))
+                               costs=dict(self.costs), seconds=condition.seconds)
 
 
 TEACHER_OPTIONS = ("kind", "mislabel_rate", "dont_know_rate", "feature_quality")
 
 
-def suite_teacher(options: dict, rng: np.random.Generator):
-    """A scripted teacher (``kind = "scripted"``, the default; ``"oracle"`` = perfect) from suite options."""
+def suite_teacher(options: dict, rng: np.random.Generator, clock=None, answer_delays: dict | None = None):
+    """A scripted teacher (``kind = "scripted"``, the default; ``"oracle"`` = perfect) from suite options; with
+    embodied costs it answers after ``answer_delays`` (per query kind) on the episode's ``clock``."""
     unknown = sorted(set(options) - set(TEACHER_OPTIONS))
     kind = options.get("kind", "scripted")
     if unknown or kind not in ("scripted", "oracle"):
         raise SettingsError(f"teacher options {options} not supported; accepted: kind = 'scripted' or 'oracle', "
                             f"mislabel_rate, dont_know_rate, feature_quality (each 0..1)")
-    return make_teacher(kind, rng=rng, **{k: v for k, v in options.items() if k != "kind"})
+    return make_teacher(kind, rng=rng, clock=clock, answer_delays=answer_delays,
+                        **{k: v for k, v in options.items() if k != "kind"})
 
 
 def run_episode(spec: EpisodeSpec, strategy: Strategy | None = None) -> dict:
@@ -86,15 +90,21 @@ def _run_episode(spec: EpisodeSpec, strategy: Strategy | None = None) -> dict:
     pools = load_pools(spec.task, spec.kitchen, spec.dataset + 1, spec.plan, data_seed=spec.data_seed)
     condition = spec.condition
     scenes = -(-condition.turns // max(condition.change_every, 1))
+    if condition.seconds is not None:  # embodied costs: the scenes come with time (dialog/embodied.py)
+        scenes = max(1, int(-(-condition.seconds // load_embodied_costs().scene_seconds(condition.change_every))))
     environment = PoolEnvironment(pools.train[spec.dataset], pools.test, pools.task, scenes)
     config = spec.settings().config()
     rngs = episode_generators(spec.episode_seed)
     if strategy is None:
-        strategy = make_strategy(spec.strategy) if spec.weights is None else spec.weights.strategy(spec.strategy)
+        strategy = make_episode_strategy(spec.strategy) if spec.weights is None else \
+            spec.weights.strategy(spec.strategy)
+    clock, delays = None, None
+    if condition.seconds is not None:  # embodied costs: one clock for the arm, the turns and the teacher's answers
+        clock, delays = VirtualClock(), load_embodied_costs().answer
     Path(spec.transcript).parent.mkdir(parents=True, exist_ok=True)
     with TranscriptWriter(spec.transcript) as transcript:
-        result = DialogManager(environment, suite_teacher(dict(spec.teacher), rngs["teacher"]),
-                               strategy, config, transcript, rngs, say=lambda _: None).run()
+        result = DialogManager(environment, suite_teacher(dict(spec.teacher), rngs["teacher"], clock, delays),
+                               strategy, config, transcript, rngs, say=lambda _: None, clock=clock).run()
     series = series_from_transcript(read_transcript(spec.transcript))
     return {"spec": asdict(spec), "label": spec.label, "series": series, "accuracy": result.accuracy,
             "seconds": time.perf_counter() - started}
@@ -116,4 +126,6 @@ def series_from_transcript(records: list[dict]) -> dict[str, list]:
         for name in counts:
             series[name].append(counts[name])
         series["spent"].append(spent)
+        if "seconds" in record:  # embodied costs: seconds used by the end of the turn
+            series.setdefault("seconds", []).append(record["ended"])
     return series

@@ -72,7 +72,7 @@ def markdown_report(suite: Suite, results: list[dict], summaries: list[Checkpoin
                     findings: list[FindingResult], seconds: float, out: Path, figures: list[Path]) -> Path:
     """``report.md``: per condition the figures, accuracy at the checkpoints inside its turns, pairwise
     tests at its last checkpoint; then every finding, tested or skipped with the reason."""
-    axis_name = "questions asked" if suite.axis == "questions" else "turns"
+    axis_name = {"questions": "questions asked", "seconds": "seconds"}.get(suite.axis, "turns")
     lines = [f"# Regression report: {suite.name}", "", suite.description, "",
              f"- task `{suite.task}`, kitchen `{suite.kitchen}`, {suite.datasets} training data sets, "
              f"seeds {list(suite.seeds)}, teacher {suite.teacher or {'kind': 'scripted'}}",
@@ -86,8 +86,10 @@ def markdown_report(suite: Suite, results: list[dict], summaries: list[Checkpoin
     figure_names = {path.name for path in figures}
     groups = group_results(results)
     for condition in suite.conditions:
-        lines += [f"## Condition `{condition.name}`: budget {condition.budget:g}, {condition.turns} turns, "
-                  f"a new scene every {condition.change_every} turns", ""]
+        embodied = "" if condition.seconds is None else \
+            f"embodied costs, {condition.seconds:g} s (at most {condition.turns} turns), "
+        lines += [f"## Condition `{condition.name}`: budget {condition.budget:g}, "
+                  f"{embodied or f'{condition.turns} turns, '}a new scene every {condition.change_every} turns", ""]
         for stem, text in (("curves", "learning curves"), ("timing", "when each strategy asked")):
             if f"{stem}-{condition.name}.png" in figure_names:
                 lines += [f"![{text}]({stem}-{condition.name}.png)", ""]
@@ -99,15 +101,19 @@ def markdown_report(suite: Suite, results: list[dict], summaries: list[Checkpoin
                       f"{condition.turns} turns.", ""]
             continue
         note = f" (checkpoints {left_out} lie beyond its {condition.turns} turns)" if left_out else ""
+        used = [] if condition.seconds is None else ["used"]
         lines += [f"Mean held-out accuracy ± standard error after this many {axis_name}{note}:", "",
-                  "| strategy | " + " | ".join(f"after {c} {axis_name}" for c in checkpoints)
-                  + " | questions | demo share |", "|---" * (len(checkpoints) + 3) + "|"]
+                  "| strategy | " + " | ".join([*(f"after {c} {axis_name}" for c in checkpoints), *used])
+                  + " | questions | demo share |", "|---" * (len(checkpoints) + 3 + len(used)) + "|"]
         for summary in rows:
             group = groups[(condition.name, summary.strategy)]
             questions = np.mean([r["series"]["questions"][-1] for r in group])
             demo_cost = np.mean([r["series"]["demo"][-1] * suite.costs.get("demo", 2) /
                                  max(r["series"]["spent"][-1], 1e-9) for r in group])
             cells = " | ".join(f"{m:.3f} ± {e:.3f}" for m, e in zip(summary.mean, summary.error))
+            if condition.seconds is not None:  # embodied costs: how many turns and seconds the episodes took
+                turns = np.mean([r["series"]["turn"][-1] for r in group])
+                cells += f" | {turns:.1f} turns, {np.mean([r['series']['seconds'][-1] for r in group]):.0f} s"
             lines.append(f"| {summary.strategy} | {cells} | {questions:.1f} | {demo_cost:.0%} |")
         column = len(checkpoints) - 1
         lines += ["", f"Two-sided Mann-Whitney U between strategies after {checkpoints[column]} {axis_name}:", "",

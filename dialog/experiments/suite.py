@@ -17,10 +17,11 @@ from learning.significance import ALTERNATIVES
 
 SUITE_DIR = Path(__file__).resolve().parents[1] / "suites"
 KINDS = ("episodes", "feature-selection", "recipes")
-AXES = ("questions", "turns", "demonstrations")
+AXES = ("questions", "turns", "demonstrations", "seconds")
 SUITE_FIELDS = ("name", "description", "analysis", "kind", "task", "kitchen", "strategies", "datasets", "seeds",
                 "checkpoints", "axis", "costs", "teacher", "options", "dataset", "data_seed", "condition", "finding")
 CONDITION_FIELDS = ("name", "budget", "turns", "change_every")
+CONDITION_OPTIONAL = ("seconds",)  # embodied costs: the time allocation in seconds (turns is then the cap)
 FINDING_FIELDS = ("id", "text", "condition", "at", "better", "than", "alternative", "than_at", "margin")
 TEACHER_KINDS = ("scripted", "oracle")
 TEACHER_RATES = ("mislabel_rate", "dont_know_rate", "feature_quality")
@@ -39,6 +40,7 @@ class Condition:
     budget: float
     turns: int
     change_every: int
+    seconds: float | None = None  # embodied costs (thesis §8.2.2): the allocation in seconds; turns is the cap
 
 
 @dataclass(frozen=True)
@@ -84,9 +86,18 @@ class Suite:
         """The ``[dataset]`` table as a hashable ((name, value), ...) for ``pools.load_pools``."""
         return tuple(sorted(self.dataset.items()))
 
-    def with_overrides(self, strategies=None, seeds=None, budget=None, datasets=None, data_seed=None) -> Suite:
-        """The suite with command-line overrides applied."""
+    def with_overrides(self, strategies=None, seeds=None, budget=None, datasets=None, data_seed=None,
+                       embodied_seconds=None) -> Suite:
+        """The suite with command-line overrides applied; ``embodied_seconds`` gives every condition without a
+        ``seconds`` allocation that many seconds (regress --embodied-costs)."""
         suite = self
+        if embodied_seconds is not None:
+            if suite.kind != "episodes":
+                raise SuiteError(f"--embodied-costs applies to episodes suites; suite '{suite.name}' is of kind "
+                                 f"'{suite.kind}'")
+            suite = replace(suite, conditions=tuple(c if c.seconds is not None else
+                                                    replace(c, seconds=float(embodied_seconds))
+                                                    for c in suite.conditions))
         if data_seed is not None:
             if isinstance(data_seed, bool) or not isinstance(data_seed, int) or data_seed < 0:
                 raise SuiteError(f"data seed must be a whole number >= 0, got {data_seed!r}")
@@ -154,6 +165,9 @@ def _suite(table: dict, where: str, known_strategies) -> Suite:
     kind = text(table, "kind", where, "episodes", choices=kind_names())
     strategies = texts(table, "strategies", where, nonempty=True)
     if known_strategies is not None and kind == "episodes":
+        from dialog.embodied import strategy_names_with_variants  # NAME+turns: DT ignoring embodied costs
+
+        known_strategies = strategy_names_with_variants(known_strategies)
         unknown = [s for s in strategies if s not in known_strategies]
         if unknown:
             raise SuiteError(f"{where}: unknown strategies {unknown}; known: {', '.join(known_strategies)}")
@@ -182,9 +196,10 @@ def _suite(table: dict, where: str, known_strategies) -> Suite:
 
 
 def _condition(table: dict, where: str) -> Condition:
-    check_keys(table, where, required=CONDITION_FIELDS)
+    check_keys(table, where, required=CONDITION_FIELDS, optional=CONDITION_OPTIONAL)
     return Condition(text(table, "name", where), number(table, "budget", where, low=0.0),
-                     integer(table, "turns", where, low=1), integer(table, "change_every", where, low=1))
+                     integer(table, "turns", where, low=1), integer(table, "change_every", where, low=1),
+                     number(table, "seconds", where, None, above=0.0))
 
 
 def _finding(table: dict, kind: str, strategies: tuple, conditions: list, where: str) -> Finding:

@@ -29,6 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from learning.actions import Action, DemoQuery, FeatureQuery, LabelQuery, NoQuery
+from learning.decision.embodied import absent_chance
 from learning.decision.features import (
     FEATURE_NAMES,
     concept_counts,
@@ -48,6 +49,7 @@ class CandidateFeatures:
     expected: np.ndarray  # (len(actions), len(FEATURE_NAMES))
     current: np.ndarray  # phi(s) now, (len(FEATURE_NAMES),); not the NoQuery row, which is at s_{t+1}
     feature_names: tuple[str, ...] = FEATURE_NAMES
+    seconds: np.ndarray | None = None  # embodied costs: E[seconds(a)] of every candidate (None: time in turns)
 
     def utilities(self, weights) -> np.ndarray:
         """EU(a) = w . E[phi(s') | a] for every candidate (eq. 7.1, 7.2)."""
@@ -76,23 +78,28 @@ def candidate_actions(state) -> tuple[Action, ...]:
 
 
 def expected_decision_features(state, engine: str | WhatIfEngine = "fast", window_factor: float = 1.0,
-                               actions: tuple[Action, ...] | None = None) -> CandidateFeatures:
+                               actions: tuple[Action, ...] | None = None, seconds: bool = True) -> CandidateFeatures:
     """E[phi(s') | a] for every candidate action of ``state`` (thesis eq. 6.3, 7.1) with the given what-if engine.
 
     ``actions`` defaults to ``candidate_actions(state)``; a caller may pass a subset (NoQuery included or not).
+    With embodied costs (``state.seconds_clock``; ``seconds`` False ignores them) every row's remaining time is
+    read at its own next state in seconds, (T_s - elapsed - E[seconds(a)]) / T_s (thesis §8.2.2), and
+    ``seconds`` of the result holds E[seconds(a)].
     """
     engine = make_engine(engine)
     actions = candidate_actions(state) if actions is None else tuple(actions)
-    clock = state_clock(state, window_factor)
+    clock = state_clock(state, window_factor, seconds)
     counts = concept_counts(state)
     P = state.probabilities()
     current = features(P, counts, clock)
     n_learning = len(current) - len(clock.features())
-    quiet = np.concatenate([current[:n_learning], clock.after(state.cost(NoQuery()), asked=False).features()])
+    durations = _expected_seconds(clock, actions, P, state.concepts)
+    quiet = np.concatenate([current[:n_learning],
+                            clock.after(state.cost(NoQuery()), asked=False, seconds=_quiet_seconds(clock)).features()])
     label_objects = [a.object_index for a in actions if a.kind == "label"]
     wants_feature_query = any(a.kind == "feature" for a in actions)
     if not (label_objects or wants_feature_query or any(a.kind == "demo" for a in actions)):
-        return CandidateFeatures(actions, np.tile(quiet, (len(actions), 1)), current)
+        return CandidateFeatures(actions, np.tile(quiet, (len(actions), 1)), current, seconds=durations)
     outcomes = engine.simulate(state, label_objects, wants_feature_query)
     n_concepts = len(state.concepts)
     with_one_more = counts + np.eye(n_concepts)  # row y: the counts after one more example of concept y
@@ -124,11 +131,24 @@ def expected_decision_features(state, engine: str | WhatIfEngine = "fast", windo
         if action.kind == "none":
             expected[i] = quiet
             continue
-        cost = state.cost(action)
-        if cost not in after:
-            after[cost] = clock.after(cost, asked=True).features()
-        expected[i, learned.shape[1] :] = after[cost]
-    return CandidateFeatures(actions, expected, current)
+        key = (state.cost(action), 0.0 if durations is None else float(durations[i]))
+        if key not in after:
+            after[key] = clock.after(key[0], asked=True, seconds=key[1]).features()
+        expected[i, learned.shape[1] :] = after[key]
+    return CandidateFeatures(actions, expected, current, seconds=durations)
+
+
+def _expected_seconds(clock, actions, P: np.ndarray, concepts) -> np.ndarray | None:
+    """E[seconds(a)] of every action with embodied costs, else None."""
+    if clock.seconds is None:
+        return None
+    absent = dict(zip(concepts, absent_chance(P)))
+    return np.array([clock.seconds.expected_seconds(a, absent.get(getattr(a, "concept", None), 0.0))
+                     for a in actions])
+
+
+def _quiet_seconds(clock) -> float:
+    return 0.0 if clock.seconds is None else clock.seconds.expected_seconds(NoQuery())
 
 
 def _normalised(column: np.ndarray) -> np.ndarray:

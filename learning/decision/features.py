@@ -25,6 +25,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from learning.decision.embodied import SecondsClock
+
 FEATURE_NAMES: tuple[str, ...] = (
     "classifier_discriminability",  # ACD, thesis §6.4.2
     "class_distribution_uniformity",  # CDU, thesis §6.4.2
@@ -106,23 +108,28 @@ class Clock:
     turns: int  # the time allocation T
     quiet_run: int  # no-query turns in a row that end now
     window: int  # |T_w|, in turns
+    seconds: SecondsClock | None = None  # embodied costs (thesis §8.2.2): the allocation in seconds, else turns
 
     def budget_consumption(self) -> float:
         """Fraction of the query budget spent; a zero budget counts as spent."""
         return 1.0 if self.budget <= 0 else float(np.clip(self.spent / self.budget, 0.0, 1.0))
 
     def remaining_time(self) -> float:
-        """Fraction of the allocated turns still to come."""
+        """Fraction of the allocated turns still to come; with embodied costs, of the allocated seconds."""
+        if self.seconds is not None:
+            return self.seconds.remaining()
         return float(np.clip((self.turns - self.turn) / self.turns, 0.0, 1.0))
 
     def non_query_time(self) -> float:
         """t_NQ = n_NQ / |T_w| (thesis §7.3.1): 0 right after a query, 1 after a window of silence."""
         return min(self.quiet_run, self.window) / self.window
 
-    def after(self, cost: float, asked: bool) -> Clock:
-        """The clock one turn later, having spent ``cost`` on a query (``asked``) or stayed quiet."""
+    def after(self, cost: float, asked: bool, seconds: float = 0.0) -> Clock:
+        """The clock one turn later, having spent ``cost`` on a query (``asked``) or stayed quiet; with embodied
+        costs the turn took ``seconds``."""
         return Clock(self.spent + cost, self.budget, self.turn + 1, self.turns,
-                     0 if asked else self.quiet_run + 1, self.window)
+                     0 if asked else self.quiet_run + 1, self.window,
+                     None if self.seconds is None else self.seconds.after(seconds))
 
     def features(self) -> np.ndarray:
         return np.array([self.budget_consumption(), self.remaining_time(), self.non_query_time()])
@@ -135,10 +142,11 @@ def window_turns(change_every: int, window_factor: float = 1.0) -> int:
     return max(1, int(round(window_factor * change_every)))
 
 
-def state_clock(state, window_factor: float = 1.0) -> Clock:
-    """The clock of a LearningState now."""
+def state_clock(state, window_factor: float = 1.0, seconds: bool = True) -> Clock:
+    """The clock of a LearningState now; ``seconds`` False ignores embodied costs (time in turns)."""
     return Clock(state.spent, state.budget, state.turn, state.turns, state.quiet_run(),
-                 window_turns(state.change_every, window_factor))
+                 window_turns(state.change_every, window_factor),
+                 getattr(state, "seconds_clock", None) if seconds else None)
 
 
 def learning_features(P: np.ndarray, counts: np.ndarray) -> np.ndarray:

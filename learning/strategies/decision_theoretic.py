@@ -8,6 +8,12 @@ nothing and lengthens the quiet run). The learner takes the best query a* only i
 EU(no query), else it asks nothing this turn; ties between queries go to the first in
 candidate order (demos, labels, FSQ). Every explanation says what no query was scored at.
 
+With embodied costs (thesis §8.2.2; the state's ``seconds_clock``) remaining time reads seconds at each
+candidate's own next state, (T_s - elapsed - E[seconds(a)]) / T_s (eq. 7.1), and of the queries that beat
+no query DT takes the one with the largest expected utility gain per expected second
+(``learning.decision.embodied.choose_per_second``): a near object before an equally useful far one.
+``embodied=False`` ignores the seconds (time in turns, the rule above) even when the episode has them.
+
 Named presets read their weights from learning/decision/presets/<name>.toml:
 ``dt`` (custom: edit the file or pass ``weights=``), ``dt-iros`` (ACD, CDU),
 ``dt-task`` (+ IV, PM) and ``dt-task-env`` (+ budget, time, non-query time;
@@ -21,6 +27,7 @@ import numpy as np
 from learning.actions import Action, Decision
 from learning.concepts import normalise_rows
 from learning.decision.candidates import CandidateFeatures, expected_decision_features
+from learning.decision.embodied import choose_per_second
 from learning.decision.weights import resolve_weights
 from learning.state import LearningState
 from learning.strategies.base import Strategy
@@ -32,27 +39,34 @@ GAIN_TOLERANCE = 1e-12
 class DecisionTheoreticStrategy(Strategy):
     """DT with any weight vector: a preset name, a TOML path, a {feature: weight} mapping or a full vector."""
 
-    def __init__(self, weights="dt", name: str | None = None, engine="fast", window_factor: float = 1.0):
+    def __init__(self, weights="dt", name: str | None = None, engine="fast", window_factor: float = 1.0,
+                 embodied: bool = True):
         self.weights = resolve_weights(weights)
         self.name = name or (weights if isinstance(weights, str) and not weights.endswith(".toml") else "dt")
         self.engine = make_engine(engine)
         self.window_factor = window_factor
+        self.embodied = embodied  # with embodied costs: remaining time in seconds, gain per expected second
         self.last_candidates: CandidateFeatures | None = None  # what the last choice saw (for IRL recording)
 
     def choose(self, state: LearningState, rng: np.random.Generator) -> Decision:
-        candidates = expected_decision_features(state, self.engine, self.window_factor)
+        candidates = expected_decision_features(state, self.engine, self.window_factor, seconds=self.embodied)
         self.last_candidates = candidates
         if len(candidates.actions) == 1:
             return self.nothing_affordable(state)
         utilities = candidates.utilities(self.weights)
-        best, stay = choose_index(utilities), candidates.no_query_index
+        best, stay = choose_index(utilities, candidates.seconds), candidates.no_query_index
         if best == stay:
             queries = utilities[:-1]
             top = int(np.argmax(queries))
             return Decision(candidates.actions[stay], _quiet_reason(state, candidates.actions[top], queries[top],
                                                                       utilities[stay]))
         action = candidates.actions[best]
-        return Decision(action, _query_reason(state, action, utilities[best], utilities[stay]))
+        reason = _query_reason(state, action, utilities[best], utilities[stay])
+        if candidates.seconds is not None:  # embodied costs: the gain per expected second chose it
+            took = candidates.seconds[best]
+            reason += (f" It should take about {took:.1f} s, {(utilities[best] - utilities[stay]) / took:.4f} "
+                       "utility a second, the most of the questions worth asking.")
+        return Decision(action, reason)
 
 
 def quiet_basis(state: LearningState) -> str:
@@ -62,8 +76,14 @@ def quiet_basis(state: LearningState) -> str:
             f"turn{'s' if run != 1 else ''} in a row")
 
 
-def choose_index(utilities: np.ndarray) -> int:
-    """argmax over the candidates, no query (the last) unless a query beats it by more than rounding."""
+def choose_index(utilities: np.ndarray, seconds: np.ndarray | None = None) -> int:
+    """argmax over the candidates, no query (the last) unless a query beats it by more than rounding.
+
+    With embodied costs (``seconds``: E[seconds(a)] of every candidate), the query with the largest gain over
+    no query per expected second among those that beat it (thesis §8.2.2 on eq. 7.1;
+    :func:`learning.decision.embodied.choose_per_second`)."""
+    if seconds is not None:
+        return choose_per_second(utilities, seconds, GAIN_TOLERANCE)
     queries, stay = utilities[:-1], utilities[-1]
     if len(queries) == 0:
         return len(utilities) - 1
