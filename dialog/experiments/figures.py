@@ -70,8 +70,20 @@ def _draw_curve(axis, x: np.ndarray, curves: np.ndarray, label: str, style: dict
     return bool(np.any((counts > 0) & ~everyone))
 
 
+def seconds_curves(group: list[dict], grid: np.ndarray) -> np.ndarray:
+    """(episodes x len(grid)) embodied costs: the accuracy of the last turn each episode ended by each second."""
+    curves = np.full((len(group), len(grid)), np.nan)
+    for row, result in enumerate(group):
+        ended = np.asarray(result["series"].get("seconds", []), dtype=float)
+        accuracy = np.asarray(result["series"]["accuracy"], dtype=float)
+        done = np.searchsorted(ended, grid, side="right")  # turns ended by each moment
+        curves[row, done > 0] = accuracy[done[done > 0] - 1]
+    return curves
+
+
 def learning_curve_figure(results: list[dict], suite: Suite, condition: Condition) -> Figure:
-    """Accuracy against questions asked (left) and turns (right) for every strategy of one condition."""
+    """Accuracy against questions asked (left) and turns (right; seconds with embodied costs) for every strategy
+    of one condition."""
     figure = Figure(figsize=(12, 4.8))
     axes = figure.subplots(1, 2)
     groups, styles = group_results(results), strategy_styles(suite.strategies)
@@ -81,11 +93,18 @@ def learning_curve_figure(results: list[dict], suite: Suite, condition: Conditio
         if not group:
             continue
         asked = int(max(r["series"]["questions"][-1] for r in group)) + 1
+        if condition.seconds is not None:  # embodied costs: the right panel against seconds
+            faded[0] |= _draw_curve(axes[0], np.arange(asked), accuracy_curves(group, "questions", asked), strategy,
+                                    styles[strategy])
+            grid = np.linspace(0.0, condition.seconds, 121)
+            faded[1] |= _draw_curve(axes[1], grid, seconds_curves(group, grid), strategy, styles[strategy])
+            continue
         for panel, (key, length) in enumerate((("questions", asked), ("turn", condition.turns))):
             x = np.arange(length) if key == "questions" else np.arange(1, length + 1)
             faded[panel] |= _draw_curve(axes[panel], x, accuracy_curves(group, key, length), strategy,
                                         styles[strategy])
-    for axis, label, fewer in zip(axes, ("questions asked", "turn"), faded):
+    right = "turn" if condition.seconds is None else "seconds (embodied costs)"
+    for axis, label, fewer in zip(axes, ("questions asked", right), faded):
         axis.set_xlabel(label)
         axis.set_ylabel("held-out accuracy")
         axis.grid(alpha=0.3)
@@ -95,7 +114,8 @@ def learning_curve_figure(results: list[dict], suite: Suite, condition: Conditio
             labels.append("faded: fewer episodes reach it")
         axis.legend(handles, labels, fontsize=7, loc="lower right", ncol=2 if len(labels) > 5 else 1)
     episodes = suite.datasets * len(suite.seeds)
-    figure.suptitle(f"{suite.name}: {condition.name} (budget {condition.budget:g}, {condition.turns} turns, change "
+    allocation = f"{condition.turns} turns" if condition.seconds is None else f"{condition.seconds:g} s"
+    figure.suptitle(f"{suite.name}: {condition.name} (budget {condition.budget:g}, {allocation}, change "
                     f"every {condition.change_every}); mean ± standard error over {episodes} episodes per strategy")
     figure.tight_layout()
     return figure
