@@ -132,7 +132,8 @@ def load_pointing_model(path: str | Path = POINTING_FILE) -> tuple[PointingModel
 
 
 @lru_cache(maxsize=4)
-def load_embodied_costs(costs_path: str | Path = COSTS_FILE, pointing_path: str | Path = POINTING_FILE) -> EmbodiedCosts:
+def load_embodied_costs(costs_path: str | Path = COSTS_FILE,
+                        pointing_path: str | Path = POINTING_FILE) -> EmbodiedCosts:
     """Both data files, checked field by field; the model must have been measured at the arm's joint speed."""
     where = str(costs_path)
     table = read_toml(costs_path, "embodied costs")

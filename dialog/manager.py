@@ -214,7 +214,8 @@ class DialogManager:
     def pointing_seconds(self) -> np.ndarray:
         """Each scene object's expected pointing seconds (embodied costs), from its measured distance and bearing."""
         if self._pointing is None or self._pointing[0] != self.scene.scene_id:
-            self._pointing = (self.scene.scene_id, self.embodied.pointing_seconds(self.scene.X, self.scene.feature_names))
+            seconds = self.embodied.pointing_seconds(self.scene.X, self.scene.feature_names)
+            self._pointing = (self.scene.scene_id, seconds)
         return self._pointing[1]
 
     def admissible(self, action: Action) -> tuple[Action, str]:

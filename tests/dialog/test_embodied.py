@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from dialog.clock import VirtualClock
 from dialog.cli import main
+from dialog.clock import VirtualClock
 from dialog.embodied import (
     BEARING,
     DISTANCE,
