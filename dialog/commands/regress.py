@@ -16,6 +16,7 @@ from dialog.experiments.kinds import RunOptions, get_kind, run_suite
 from dialog.experiments.suite import load_suite, suite_names
 from dialog.output_paths import check_writable, writing
 from dialog.user_weights import named_weights, read_named_weights
+from learning.errors import SettingsError
 from learning.strategies import STRATEGY_NAMES
 
 
@@ -67,6 +68,9 @@ def run(args: argparse.Namespace) -> int:
                                               embodied_seconds=_embodied_seconds(args)))
     if args.check:
         refuse_other_data_seed(suite)  # before anything runs
+        if args.embodied_costs:
+            raise SettingsError("--check compares with the stored baseline, which was made in turns; run "
+                                "--embodied-costs without --check")
     out = args.results or Path("results") / suite.name
     check_writable(out, "results", folder=True)
     with writing(out, "results", inside=True):
