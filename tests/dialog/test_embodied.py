@@ -134,6 +134,7 @@ def test_dt_in_turns_ignores_the_seconds(tmp_path):
     (["teach", "--time", "1.5"], "is not a number of turns"),
     (["demo", "--time", "600s"], "a time in seconds needs --embodied-costs"),
     (["demo", "--time", "20", "--turns", "25"], "both give the time allocation; give one"),
+    (["regress", "--suite", "smoke", "--embodied-costs", "--check"], "the stored baseline, which was made in turns"),
 ])
 def test_bad_time_values_are_refused_in_one_line(argv, expected, capsys):
     try:
@@ -142,3 +143,14 @@ def test_bad_time_values_are_refused_in_one_line(argv, expected, capsys):
         code = exit_.code
     err = capsys.readouterr().err
     assert code == 2 and expected in err and err.count("\n") == 1, err
+
+
+def test_a_persons_clock_with_embodied_costs_counts_the_arms_simulated_seconds():
+    from dialog.clock import WallClock
+
+    now = [100.0]
+    plain, embodied = WallClock(monotonic=lambda: now[0]), WallClock(monotonic=lambda: now[0], counts_simulated=True)
+    now[0] += 5.0
+    plain.advance(3.0)
+    embodied.advance(3.0)
+    assert plain.now() == pytest.approx(5.0) and embodied.now() == pytest.approx(8.0)
