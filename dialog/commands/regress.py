@@ -11,7 +11,12 @@ import json
 from pathlib import Path
 
 from dialog.commands._arguments import budget, data_seed, positive_int, seeds
-from dialog.experiments.baseline import baseline_path, refuse_other_data_seed, write_baseline
+from dialog.experiments.baseline import (
+    baseline_path,
+    refuse_baseline_from_another_run,
+    refuse_other_data_seed,
+    write_baseline,
+)
 from dialog.experiments.kinds import RunOptions, get_kind, run_suite
 from dialog.experiments.suite import load_suite, suite_names
 from dialog.output_paths import check_writable, writing
@@ -66,6 +71,8 @@ def run(args: argparse.Namespace) -> int:
     suite = kind.load(original.with_overrides(strategies=args.strategies, seeds=args.seeds, budget=args.budget,
                                               datasets=args.datasets, data_seed=args.data_seed,
                                               embodied_seconds=_embodied_seconds(args)))
+    if args.update_baseline:
+        refuse_baseline_from_another_run(suite, original.data_seed)  # before anything runs
     if args.check:
         refuse_other_data_seed(suite)  # before anything runs
         if args.embodied_costs:

@@ -9,6 +9,7 @@ import numpy as np
 
 from dialog.experiments.analysis import CheckpointSummary
 from dialog.experiments.suite import SUITE_DIR, Suite, SuiteError
+from learning.errors import SettingsError
 
 BASELINE_DIR = SUITE_DIR / "baselines"
 DEFAULT_TOLERANCE = 0.05
@@ -48,6 +49,19 @@ def refuse_other_data_seed(suite: Suite, path: Path | None = None) -> None:
     if stored != suite.data_seed:
         raise SuiteError(f"--check: the baseline {path} was made on the data sets of data seed {stored}, this run "
                          f"uses data seed {suite.data_seed}; check with --data-seed {stored}, or run without --check")
+
+
+def refuse_baseline_from_another_run(suite: Suite, own_data_seed: int) -> None:
+    """``--update-baseline`` stores only the suite's own run: refuse (SettingsError, before anything runs) a run
+    that adds --weights strategies or uses data sets of another seed than the suite's ``own_data_seed``."""
+    if suite.weights:
+        raise SettingsError(f"--update-baseline stores the suite's own run as the baseline of '{suite.name}'; this run "
+                            f"adds --weights strategies ({', '.join(suite.weights)}): run it without "
+                            "--update-baseline, or store the baseline without --weights")
+    if suite.data_seed != own_data_seed:
+        raise SettingsError(f"--update-baseline stores the suite's own run as the baseline of '{suite.name}', made on "
+                            f"the data sets of data seed {own_data_seed}; this run uses data seed {suite.data_seed}: "
+                            "run it without --update-baseline, or store the baseline without --data-seed")
 
 
 def check_against_baseline(suite: Suite, summaries: list[CheckpointSummary], path: Path | None = None) -> list[str]:

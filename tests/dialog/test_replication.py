@@ -11,7 +11,13 @@ import pytest
 
 from dialog.cli import main
 from dialog.experiments import pools
-from dialog.experiments.baseline import check_against_baseline, refuse_other_data_seed, write_baseline
+from dialog.experiments.baseline import (
+    baseline_path,
+    check_against_baseline,
+    refuse_baseline_from_another_run,
+    refuse_other_data_seed,
+    write_baseline,
+)
 from dialog.experiments.episodes import run_episode
 from dialog.experiments.runner import episode_specs
 from dialog.experiments.suite import SuiteError, load_suite
@@ -209,6 +215,32 @@ def test_regress_check_on_another_data_seed_is_refused_before_anything_runs(tmp_
     err = capsys.readouterr().err
     assert "teachbot regress: --check: the baseline" in err and "data seed 0" in err and "data seed 1" in err
     assert not (tmp_path / "out" / "report.md").exists()
+
+
+@pytest.mark.parametrize("extra", [["--weights", "mine=WEIGHTS"], ["--data-seed", "1"]])
+def test_regress_update_baseline_with_a_run_not_the_suite_s_own_is_refused_before_anything_runs(
+        tmp_path, capsys, extra):
+    stored = baseline_path(load_suite("smoke")).read_bytes()
+    extra = [value.replace("WEIGHTS", _weights_file(tmp_path)) for value in extra]
+    code = main(["regress", "--suite", "smoke", "--update-baseline", *extra, "--results", str(tmp_path / "out"),
+                 "--no-progress"])
+    assert code == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith("teachbot regress: --update-baseline stores the suite's own run")
+    assert ("--weights strategies (mine)" in err) if extra[0] == "--weights" else ("this run uses data seed 1" in err)
+    assert not (tmp_path / "out").exists()
+    assert baseline_path(load_suite("smoke")).read_bytes() == stored
+
+
+def test_update_baseline_accepts_the_suite_s_own_data_seed_and_refuses_others(tmp_path):
+    suite = load_suite(_suite_file_text(tmp_path, "data_seed = 3\n" + TINY))
+    refuse_baseline_from_another_run(suite, suite.data_seed)  # the suite's own run: fine
+    refuse_baseline_from_another_run(suite.with_overrides(data_seed=3), suite.data_seed)  # --data-seed 3 is its own
+    with pytest.raises(SettingsError, match="made on the data sets of data seed 3; this run uses data seed 0"):
+        refuse_baseline_from_another_run(suite.with_overrides(data_seed=0), suite.data_seed)
+    weighted = suite.with_weights(read_named_weights([("mine", _weights_file(tmp_path))]))
+    with pytest.raises(SettingsError, match=r"adds --weights strategies \(mine\)"):
+        refuse_baseline_from_another_run(weighted, suite.data_seed)
 
 
 def test_regress_weights_errors_are_one_line(tmp_path, capsys):
