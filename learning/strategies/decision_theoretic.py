@@ -26,17 +26,17 @@ import numpy as np
 
 from learning.actions import Action, Decision
 from learning.concepts import normalise_rows
-from learning.decision.candidates import CandidateFeatures, expected_decision_features
+from learning.decision.candidates import CandidateFeatures
 from learning.decision.embodied import choose_per_second
 from learning.decision.weights import resolve_weights
 from learning.state import LearningState
-from learning.strategies.base import Strategy
+from learning.strategies.candidate_based import CandidateStrategy
 from learning.whatif import make_engine
 
 GAIN_TOLERANCE = 1e-12
 
 
-class DecisionTheoreticStrategy(Strategy):
+class DecisionTheoreticStrategy(CandidateStrategy):
     """DT with any weight vector: a preset name, a TOML path, a {feature: weight} mapping or a full vector."""
 
     def __init__(self, weights="dt", name: str | None = None, engine="fast", window_factor: float = 1.0,
@@ -49,10 +49,9 @@ class DecisionTheoreticStrategy(Strategy):
         self.last_candidates: CandidateFeatures | None = None  # what the last choice saw (for IRL recording)
 
     def choose(self, state: LearningState, rng: np.random.Generator) -> Decision:
-        candidates = expected_decision_features(state, self.engine, self.window_factor, seconds=self.embodied)
-        self.last_candidates = candidates
-        if len(candidates.actions) == 1:
-            return self.nothing_affordable(state)
+        candidates, nothing = self.candidates(state, seconds=self.embodied)
+        if nothing is not None:
+            return nothing
         utilities = candidates.utilities(self.weights)
         best, stay = choose_index(utilities, candidates.seconds), candidates.no_query_index
         if best == stay:

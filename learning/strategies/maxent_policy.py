@@ -2,7 +2,7 @@
 
 IRL's learner plays its rollouts with this strategy. Each turn it computes the
 candidates and E[phi(s') | a] exactly as the DT strategy does
-(``learning.decision.candidates.expected_decision_features``), draws one
+(``CandidateStrategy.candidates``, learning/strategies/candidate_based.py), draws one
 action from the MaxEnt policy with its own ``numpy.random.Generator``, and
 records the turn as an IRL ``DecisionTurn``, so the rollout's feature counts
 are comparable with those of the expert's demonstrations.
@@ -13,16 +13,15 @@ from __future__ import annotations
 import numpy as np
 
 from learning.actions import Decision
-from learning.decision.candidates import expected_decision_features
 from learning.decision.features import FEATURE_NAMES
 from learning.irl.demonstrations import DecisionTurn, QuestioningEpisode
 from learning.irl.policy import policy_probabilities
 from learning.state import LearningState
-from learning.strategies.base import Strategy
+from learning.strategies.candidate_based import CandidateStrategy
 from learning.whatif import make_engine
 
 
-class MaxEntPolicyStrategy(Strategy):
+class MaxEntPolicyStrategy(CandidateStrategy):
     """Samples each turn's action from the MaxEnt policy with weights ``weights`` (FEATURE_NAMES order)."""
 
     name = "maxent-policy"
@@ -41,9 +40,9 @@ class MaxEntPolicyStrategy(Strategy):
 
     def choose(self, state: LearningState, rng: np.random.Generator) -> Decision:
         """One action drawn from P(a|s, w); the episode's generator ``rng`` is left alone (the strategy has its own)."""
-        candidates = expected_decision_features(state, self.engine, self.window_factor)
-        if len(candidates.actions) == 1:
-            index, decision = 0, self.nothing_affordable(state)
+        candidates, nothing = self.candidates(state)
+        if nothing is not None:
+            index, decision = 0, nothing
         else:
             probabilities = policy_probabilities(candidates.expected, self.weights)
             index = int(self.rng.choice(len(probabilities), p=probabilities))

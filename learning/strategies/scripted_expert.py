@@ -41,10 +41,10 @@ import numpy as np
 
 from learning.actions import Action, Decision, DemoQuery, FeatureQuery, LabelQuery, NoQuery
 from learning.datafiles import check_keys, integer, number, read_toml, section
-from learning.decision.candidates import CandidateFeatures, expected_decision_features
+from learning.decision.candidates import CandidateFeatures
 from learning.decision.features import label_distribution
 from learning.state import LearningState
-from learning.strategies.base import Strategy
+from learning.strategies.candidate_based import CandidateStrategy
 from learning.whatif import make_engine
 
 RULES_FILE = Path(__file__).parent / "data" / "scripted-expert.toml"
@@ -130,7 +130,7 @@ class ExpertPlan:
         return wishes
 
 
-class ScriptedExpertStrategy(Strategy):
+class ScriptedExpertStrategy(CandidateStrategy):
     """The scripted expert as a strategy: the candidates exactly as DT computes them, the choice by ``ExpertPlan``."""
 
     name = "scripted-expert"
@@ -142,9 +142,8 @@ class ScriptedExpertStrategy(Strategy):
         self.last_candidates: CandidateFeatures | None = None  # what the last choice saw (for IRL recording)
 
     def choose(self, state: LearningState, rng: np.random.Generator) -> Decision:
-        candidates = expected_decision_features(state, self.engine, self.window_factor)
-        self.last_candidates = candidates
-        if len(candidates.actions) == 1:
-            return self.nothing_affordable(state)
+        candidates, nothing = self.candidates(state)
+        if nothing is not None:
+            return nothing
         action, reason = self.plan.choose(state.turn + 1, state, candidates, rng)
         return Decision(action, reason)
