@@ -2,10 +2,12 @@
 
 ``dialog/data/embodied-costs.toml`` holds the durations set by hand (the arm's joint speed, saying each
 question, the teacher's expected answer time per query kind, a quiet turn), each documented there;
-``dialog/data/pointing-time.toml`` holds the motion-time model measured on the real arm by
+``dialog/data/pointing-time.toml`` holds the motion-time models measured on the real arm by
 ``scripts/fit_motion_time.py``: seconds = sum_k c_k term_k(distance, |bearing|) with non-negative
 coefficients (so a farther object, or one more to the side, never takes less), clipped to the measured
-range, plus the measured mean seconds of a pantry fetch, with its provenance.
+range; one from rest (the first gesture in a scene) and one from the object pointed at last (the arm
+does not rest between gestures within a scene), on the differences of the two objects' distances and
+bearings; plus the measured mean seconds of a pantry fetch, with its provenance.
 
 :class:`EmbodiedCosts` turns a scene's measured ``location.robot.distance`` and ``location.robot.bearing``
 into each object's expected pointing seconds, and makes the learner's
@@ -73,6 +75,7 @@ class EmbodiedCosts:
     fetch: float
     pointing: PointingModel
     turn_length: float = 10.0  # a nominal turn's seconds: the world changes every change_every of them
+    onward: PointingModel | None = None  # from the previously pointed object (None: always from rest)
 
     def scene_seconds(self, change_every: int) -> float:
         """With embodied costs a new scene comes every ``change_every`` nominal turns, in seconds."""
@@ -82,14 +85,18 @@ class EmbodiedCosts:
         """Each kind's expected seconds apart from the arm: saying the question and the answer; a quiet turn."""
         return {**{kind: self.speaking[kind] + self.answer[kind] for kind in QUERY_KINDS}, "none": self.quiet}
 
-    def pointing_seconds(self, X: np.ndarray, feature_names) -> np.ndarray:
-        """Each scene object's expected pointing seconds from its measured distance and bearing to the robot."""
+    def pointing_seconds(self, X: np.ndarray, feature_names, last: int | None = None) -> np.ndarray:
+        """Each scene object's expected pointing seconds from its measured distance and bearing to the robot:
+        from rest, or (``last``) from above scene object ``last``, where the arm pointed last."""
         names = list(feature_names)
         missing = [name for name in (DISTANCE, BEARING) if name not in names]
         if missing:
             raise DataFileError(f"embodied costs need the features {', '.join(missing)} in every scene")
         X = np.asarray(X, dtype=float)
-        return self.pointing.seconds(X[:, names.index(DISTANCE)], X[:, names.index(BEARING)])
+        distance, bearing = X[:, names.index(DISTANCE)], X[:, names.index(BEARING)]
+        if last is None or self.onward is None:
+            return self.pointing.seconds(distance, bearing)
+        return self.onward.seconds(np.abs(distance - distance[last]), np.abs(bearing - bearing[last]))
 
     def clock(self, allocation: float, elapsed: float, pointing: np.ndarray, can_fetch: bool) -> SecondsClock:
         return SecondsClock(float(allocation), float(elapsed), self.turn_seconds(), pointing,
@@ -99,6 +106,7 @@ class EmbodiedCosts:
         """What a transcript header keeps of the model (to tell runs apart)."""
         return {"joint_speed": self.joint_speed, "speaking": dict(self.speaking), "answer": dict(self.answer),
                 "quiet": self.quiet, "fetch": self.fetch, "pointing": list(self.pointing.coefficients),
+                "pointing_onward": None if self.onward is None else list(self.onward.coefficients),
                 "turn_seconds": self.turn_length}
 
 
@@ -108,13 +116,31 @@ def _kinds(table: dict, key: str, where: str) -> dict[str, float]:
     return {kind: number(part, kind, here, low=0.0) for kind in QUERY_KINDS}
 
 
+MODEL_FIELDS = ("terms", "coefficients", "distance_range", "bearing_range", "joint_speed")
+MODEL_FIGURES = ("n", "seconds_range", "rms_residual_seconds", "max_abs_residual_seconds", "r_squared",
+                 "held_out_kitchen_rms_seconds")  # how well it fits: recorded, not used
+
+
 def load_pointing_model(path: str | Path = POINTING_FILE) -> tuple[PointingModel, float]:
-    """The motion-time model and the mean pantry-fetch seconds of ``pointing-time.toml``."""
+    """The motion-time model from rest and the mean pantry-fetch seconds of ``pointing-time.toml``."""
+    models, fetch = load_pointing_models(path)
+    return models[0], fetch
+
+
+def load_pointing_models(path: str | Path = POINTING_FILE) -> tuple[tuple[PointingModel, PointingModel], float]:
+    """The models from rest ([model]) and from the previous object ([from_previous]), and the fetch seconds."""
     where = str(path)
     table = read_toml(path, "pointing-time model")
-    check_keys(table, where, required=("model", "fetch", "provenance"))
-    model, here = section(table, "model", where), f"{where} [model]"
-    check_keys(model, here, required=("terms", "coefficients", "distance_range", "bearing_range", "joint_speed"))
+    check_keys(table, where, required=("model", "from_previous", "fetch", "provenance"))
+    models = (_pointing_table(table, "model", where), _pointing_table(table, "from_previous", where))
+    fetch, here_fetch = section(table, "fetch", where), f"{where} [fetch]"
+    check_keys(fetch, here_fetch, required=("mean_seconds",), optional=("n", "sd_seconds"))
+    return models, number(fetch, "mean_seconds", here_fetch, low=0.0)
+
+
+def _pointing_table(table: dict, name: str, where: str) -> PointingModel:
+    model, here = section(table, name, where), f"{where} [{name}]"
+    check_keys(model, here, required=MODEL_FIELDS, optional=MODEL_FIGURES)
     terms = texts(model, "terms", here, nonempty=True)
     unknown = [t for t in terms if t not in TERMS]
     if unknown:
@@ -124,11 +150,8 @@ def load_pointing_model(path: str | Path = POINTING_FILE) -> tuple[PointingModel
     for key, (low, high) in zip(("distance_range", "bearing_range"), ranges):
         if low > high:
             raise DataFileError(f"{here}: '{key}' must be [low, high] with low <= high, got [{low}, {high}]")
-    fetch, here_fetch = section(table, "fetch", where), f"{where} [fetch]"
-    check_keys(fetch, here_fetch, required=("mean_seconds",), optional=("n", "sd_seconds"))
-    pointing = PointingModel(tuple(terms), tuple(float(c) for c in coefficients), tuple(ranges[0]),
-                             tuple(ranges[1]), number(model, "joint_speed", here, above=0.0))
-    return pointing, number(fetch, "mean_seconds", here_fetch, low=0.0)
+    return PointingModel(tuple(terms), tuple(float(c) for c in coefficients), tuple(ranges[0]), tuple(ranges[1]),
+                         number(model, "joint_speed", here, above=0.0))
 
 
 @lru_cache(maxsize=4)
@@ -143,14 +166,15 @@ def load_embodied_costs(costs_path: str | Path = COSTS_FILE,
     check_keys(arm, f"{where} [arm]", required=("joint_speed",))
     check_keys(quiet, f"{where} [quiet]", required=("seconds",))
     joint_speed = number(arm, "joint_speed", f"{where} [arm]", above=0.0)
-    pointing, fetch = load_pointing_model(pointing_path)
-    if abs(pointing.joint_speed - joint_speed) > 1e-9:
-        raise DataFileError(f"{pointing_path}: the pointing-time model was measured at a joint speed of "
-                            f"{pointing.joint_speed:g} rad/s, {where} sets {joint_speed:g}; refit it with "
-                            "scripts/fit_motion_time.py")
+    (pointing, onward), fetch = load_pointing_models(pointing_path)
+    for model in (pointing, onward):
+        if abs(model.joint_speed - joint_speed) > 1e-9:
+            raise DataFileError(f"{pointing_path}: the pointing-time model was measured at a joint speed of "
+                                f"{model.joint_speed:g} rad/s, {where} sets {joint_speed:g}; refit it with "
+                                "scripts/fit_motion_time.py")
     return EmbodiedCosts(joint_speed, _kinds(table, "speaking", where), _kinds(table, "answer", where),
                          number(quiet, "seconds", f"{where} [quiet]", above=0.0), fetch, pointing,
-                         number(world, "turn_seconds", f"{where} [world]", above=0.0))
+                         number(world, "turn_seconds", f"{where} [world]", above=0.0), onward)
 
 
 TURNS_SUFFIX = "+turns"  # a DT strategy that ignores embodied costs (time in turns), to compare with

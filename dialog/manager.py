@@ -127,7 +127,8 @@ class DialogManager:
         self._undo_stack: list[tuple] = []
         self.questioner = Questioner(environment, self.state, config.pictures)
         self.embodied = load_embodied_costs() if config.seconds is not None else None  # dialog/embodied.py
-        self._pointing: tuple[int, np.ndarray] | None = None  # (scene id, each object's expected pointing seconds)
+        self._pointing: tuple | None = None  # ((scene id, last pointed), each object's expected pointing seconds)
+        self._last_pointed: int | None = None  # the scene object the arm points at now (None: at rest)
 
     # -- episode ------------------------------------------------------------------
     def header(self) -> dict:
@@ -204,6 +205,7 @@ class DialogManager:
             self.scene = self.env.next_scene(self.rngs["scenes"])
             self._epoch = max(epoch, self._epoch + 1)
             self.state.observe_scene(self.scene.scene_id, self.scene.X)
+            self._last_pointed = None  # the arm rests before the world is observed again
             self._notify("on_scene", self.scene)
             self.say(f"-- turn {self.turn + 1}: the robot looks at a new scene of {self.scene.n_objects} objects")
         if self.embodied is not None:
@@ -212,11 +214,17 @@ class DialogManager:
         return start
 
     def pointing_seconds(self) -> np.ndarray:
-        """Each scene object's expected pointing seconds (embodied costs), from its measured distance and bearing."""
-        if self._pointing is None or self._pointing[0] != self.scene.scene_id:
-            seconds = self.embodied.pointing_seconds(self.scene.X, self.scene.feature_names)
-            self._pointing = (self.scene.scene_id, seconds)
+        """Each scene object's expected pointing seconds (embodied costs), from its measured distance and bearing,
+        from rest or from the object the arm points at now."""
+        key = (self.scene.scene_id, self._last_pointed)
+        if self._pointing is None or self._pointing[0] != key:
+            self._pointing = (key, self.embodied.pointing_seconds(self.scene.X, self.scene.feature_names,
+                                                                  self._last_pointed))
         return self._pointing[1]
+
+    def note_pointed(self, index: int | None) -> None:
+        """The arm now points at scene object ``index`` (None: it rested, e.g. after a fetch)."""
+        self._last_pointed = index
 
     def admissible(self, action: Action) -> tuple[Action, str]:
         """The action itself if it may be taken now, else no query and the reason."""
@@ -265,6 +273,7 @@ class DialogManager:
                     record["gesture"] = {**record["gesture"], "model_seconds": modelled}
                     self.clock.advance(modelled)
                 self.clock.advance(record["gesture"].get("sim_seconds", 0.0))
+                self.note_pointed(action.object_index)
             if self.embodied is not None:  # saying the question
                 self.clock.advance(self.embodied.speaking[action.kind])
             prompt = self.prompt_for(action, explanation, number, start)
@@ -360,6 +369,7 @@ class DialogManager:
         here"); a fetch that fails is told in the dialog, never raised. Returns the extra fields and the change."""
         fetched = self.env.fetch(scene, action.concept, self.rngs["pantry"]) or {}
         self.clock.advance(fetched.get("sim_seconds", 0.0))
+        self.note_pointed(None)  # the arm rests after reaching into the pantry
         reason = fetched.get("reason", "the pantry had none")
         if fetched.get("x") is not None:
             try:

@@ -45,6 +45,7 @@ def replay_turn(manager, record: dict) -> None:
                                              manager.state.concepts)
     if not problem and action.kind == "label":
         gesture = manager.env.point_at(manager.scene, action.object_index)
+        manager.note_pointed(action.object_index)  # the arm now points there, as it did in the session
         problem = checks.gesture_difference(record.get("gesture"), gesture)
         problem = problem and f"the arm's gesture did not repeat ({problem}): the arm or the scene changed"
     if problem:

@@ -10,7 +10,10 @@ arm rests, then really points at it (``robot.gestures.point_at`` at the joint sp
 measured ``location.robot.distance`` and ``location.robot.bearing`` (the features every data-set row has).
 The model is non-negative least squares on a few terms of distance d and |bearing| b
 (1, d, b, d^2, b^2, d*b): every coefficient >= 0, so a farther object, or one further to the side, never
-takes less. Residuals are reported on the fitted points and on a held-out kitchen (each kitchen left
+takes less. Within a scene the arm does not rest between gestures, so after each pointing from rest it
+also points at a random other object of the scene, and a second model of the same form is fitted on the
+absolute differences of the two objects' distances and bearings (pointing from the previous object).
+Residuals are reported on the fitted points and on a held-out kitchen (each kitchen left
 out in turn). The arm also fetches a few examples from each kitchen's pantry; their mean seconds go in
 the file too. The file records its provenance: commit, kitchens, tasks, seeds, n, residual error.
 """
@@ -38,12 +41,13 @@ from learning.datafiles import read_toml  # noqa: E402
 DEFAULT_TASKS = ("pack-lunchbox", "prepare-lunch")
 
 
-def measure(tasks, kitchens, seeds, joint_speed: float, fetches: int) -> tuple[list[dict], list[float]]:
-    """Pointing times of every object of every scene, and a few pantry fetches' seconds."""
+def measure(tasks, kitchens, seeds, joint_speed: float, fetches: int) -> tuple[list[dict], list[dict], list[float]]:
+    """Pointing times of every object of every scene from rest, the same from the previously pointed object
+    (object i, then a random other object j, as the arm goes within a scene), and a few pantry fetches."""
     from dialog.environment import SimulatedKitchen
     from robot.gestures import point_at
 
-    rows, fetched = [], []
+    rows, onward, fetched = [], [], []
     for kitchen in kitchens:
         for task in tasks:
             env = SimulatedKitchen(task=task, kitchen=kitchen, seed=0, joint_speed=joint_speed)
@@ -60,6 +64,12 @@ def measure(tasks, kitchens, seeds, joint_speed: float, fetches: int) -> tuple[l
                         rows.append({"kitchen": kitchen, "task": task, "seed": seed, "object": i,
                                      "distance": float(scene.X[i, d]), "bearing": float(scene.X[i, b]),
                                      "seconds": result.sim_seconds, "reached": bool(result.reached)})
+                        j = int(rng.choice([k for k in range(scene.n_objects) if k != i]))
+                        result = point_at(env.arm, scene.positions[j], scene.tops[j], joint_speed)
+                        onward.append({"kitchen": kitchen, "task": task, "seed": seed, "object": j,
+                                       "distance": abs(float(scene.X[j, d] - scene.X[i, d])),
+                                       "bearing": abs(float(scene.X[j, b] - scene.X[i, b])),
+                                       "seconds": result.sim_seconds, "reached": bool(result.reached)})
                     env.arm.rest()
                     for k in range(fetches if task == tasks[0] else 0):
                         concept = env.concepts[k % len(env.concepts)]
@@ -70,7 +80,29 @@ def measure(tasks, kitchens, seeds, joint_speed: float, fetches: int) -> tuple[l
                         env.arm.rest()
             finally:
                 env.close()
-    return rows, fetched
+    return rows, onward, fetched
+
+
+def summarise_fit(rows: list[dict], kitchens, terms) -> dict:
+    """The non-negative least-squares fit on ``rows`` and its residuals (leave-one-kitchen-out too)."""
+    coefficients = fit(rows, terms)
+    res = residuals(rows, terms, coefficients)
+    seconds = np.array([r["seconds"] for r in rows])
+    held = []
+    for kitchen in kitchens:
+        train = [r for r in rows if r["kitchen"] != kitchen]
+        test = [r for r in rows if r["kitchen"] == kitchen]
+        if train and test:
+            held.append(residuals(test, terms, fit(train, terms)))
+    distances, bearings = [r["distance"] for r in rows], [abs(r["bearing"]) for r in rows]
+    return {"terms": list(terms), "coefficients": [float(c) for c in coefficients],
+            "distance_range": [float(min(distances)), float(max(distances))],
+            "bearing_range": [float(min(bearings)), float(max(bearings))],
+            "rms": float(np.sqrt(np.mean(res ** 2))), "max_abs": float(np.max(np.abs(res))),
+            "r2": float(1 - np.sum(res ** 2) / np.sum((seconds - seconds.mean()) ** 2)),
+            "held_out_rms": float(np.sqrt(np.mean(np.concatenate(held) ** 2))) if held else float("nan"),
+            "n": len(rows), "seconds_range": [float(seconds.min()), float(seconds.max())],
+            "mean_seconds": float(seconds.mean())}
 
 
 def fit(rows: list[dict], terms) -> np.ndarray:
@@ -98,20 +130,33 @@ def toml_file(summary: dict) -> str:
     def array(values, digits=6):
         return "[" + ", ".join(f"{v:.{digits}g}" if isinstance(v, float) else json.dumps(v) for v in values) + "]"
 
-    fit_ = summary["fit"]
-    return f"""# The Panda's pointing time, measured in the simulation: seconds = sum_k coefficients[k] * term_k,
-# d = location.robot.distance (m), b = |location.robot.bearing| (rad), both clipped to the measured
-# ranges. Written by scripts/fit_motion_time.py --write (non-negative least squares); do not edit by
-# hand, refit. Read by dialog/embodied.py. The arm rests, then points (robot.gestures.point_at at
-# joint_speed rad/s, as dialog/data/embodied-costs.toml sets it).
-
-[model]
+    def table(name: str, fit_: dict) -> str:
+        return f"""[{name}]
 terms = {array(fit_["terms"])}
 coefficients = {array(fit_["coefficients"])}
 distance_range = {array(fit_["distance_range"], 4)}
 bearing_range = {array(fit_["bearing_range"], 4)}
 joint_speed = {summary["joint_speed"]:g}
+n = {fit_["n"]}
+seconds_range = {array(fit_["seconds_range"], 4)}
+rms_residual_seconds = {fit_["rms"]:.4g}
+max_abs_residual_seconds = {fit_["max_abs"]:.4g}
+r_squared = {fit_["r2"]:.4g}
+held_out_kitchen_rms_seconds = {fit_["held_out_rms"]:.4g}
+"""
 
+    return f"""# The Panda's pointing time, measured in the simulation: seconds = sum_k coefficients[k] * term_k,
+# both inputs clipped to the measured ranges. Written by scripts/fit_motion_time.py --write
+# (non-negative least squares); do not edit by hand, refit. Read by dialog/embodied.py. The arm
+# points with robot.gestures.point_at at joint_speed rad/s, as dialog/data/embodied-costs.toml sets it.
+#
+# [model]: from rest (the first pointing in a scene; the arm rests whenever the scene changes);
+#   distance = location.robot.distance (m), bearing = |location.robot.bearing| (rad) of the object.
+# [from_previous]: from above the object pointed at last in the same scene; distance and bearing are
+#   the absolute differences between the two objects' distances and bearings to the robot.
+
+{table("model", summary["fit"])}
+{table("from_previous", summary["from_previous"])}
 [fetch]
 # a pantry fetch's simulated seconds (the reach over the pantry; scene objects to the side make it longer)
 mean_seconds = {summary["fetch"]["mean_seconds"]:.4g}
@@ -125,14 +170,18 @@ measured = "{summary["measured"]}"
 kitchens = {array(summary["kitchens"])}
 tasks = {array(summary["tasks"])}
 seeds = {array(summary["seeds"])}
-n = {summary["n"]}
+motions = {summary["n"]}
 reached = {summary["reached"]}
-seconds_range = {array(summary["seconds_range"], 4)}
-rms_residual_seconds = {fit_["rms"]:.4g}
-max_abs_residual_seconds = {fit_["max_abs"]:.4g}
-r_squared = {fit_["r2"]:.4g}
-held_out_kitchen_rms_seconds = {fit_["held_out_rms"]:.4g}
 """
+
+
+def _report(name: str, f: dict) -> None:
+    print(f"{name}: {f['n']} motions, {f['seconds_range'][0]:.2f}-{f['seconds_range'][1]:.2f} s (mean "
+          f"{f['mean_seconds']:.2f}); inputs {f['distance_range'][0]:.2f}-{f['distance_range'][1]:.2f} m, "
+          f"{f['bearing_range'][0]:.2f}-{f['bearing_range'][1]:.2f} rad")
+    print("  fit: " + " + ".join(f"{c:.3f}*{t}" for c, t in zip(f["coefficients"], f["terms"]) if c > 0))
+    print(f"  residual rms {f['rms']:.3f} s, max {f['max_abs']:.3f} s, R^2 {f['r2']:.3f}; "
+          f"leave-one-kitchen-out rms {f['held_out_rms']:.3f} s")
 
 
 def main(argv=None) -> int:
@@ -148,44 +197,21 @@ def main(argv=None) -> int:
     seeds = list(range(args.scenes))
     joint_speed = float(read_toml(COSTS_FILE, "embodied costs")["arm"]["joint_speed"])
     started = time.perf_counter()
-    rows, fetched = measure(args.tasks, kitchens, seeds, joint_speed, args.fetches)
+    rows, onward, fetched = measure(args.tasks, kitchens, seeds, joint_speed, args.fetches)
     wall = time.perf_counter() - started
     terms = tuple(TERMS)
-    coefficients = fit(rows, terms)
-    res = residuals(rows, terms, coefficients)
-    seconds = np.array([r["seconds"] for r in rows])
-    held = []
-    for kitchen in kitchens:
-        train = [r for r in rows if r["kitchen"] != kitchen]
-        test = [r for r in rows if r["kitchen"] == kitchen]
-        if train and test:
-            held.append(residuals(test, terms, fit(train, terms)))
-    held_rms = float(np.sqrt(np.mean(np.concatenate(held) ** 2))) if held else float("nan")
-    distances = [r["distance"] for r in rows]
-    bearings = [abs(r["bearing"]) for r in rows]
     summary = {
-        "n": len(rows), "reached": int(sum(r["reached"] for r in rows)), "kitchens": list(kitchens),
-        "tasks": list(args.tasks), "seeds": seeds, "joint_speed": joint_speed, "commit": commit(),
-        "measured": datetime.date.today().isoformat(), "wall_seconds": round(wall, 1),
-        "seconds_range": [float(seconds.min()), float(seconds.max())],
-        "fit": {"terms": list(terms), "coefficients": [float(c) for c in coefficients],
-                "distance_range": [float(min(distances)), float(max(distances))],
-                "bearing_range": [float(min(bearings)), float(max(bearings))],
-                "rms": float(np.sqrt(np.mean(res ** 2))), "max_abs": float(np.max(np.abs(res))),
-                "r2": float(1 - np.sum(res ** 2) / np.sum((seconds - seconds.mean()) ** 2)),
-                "held_out_rms": held_rms},
+        "n": len(rows) + len(onward), "reached": int(sum(r["reached"] for r in rows + onward)),
+        "kitchens": list(kitchens), "tasks": list(args.tasks), "seeds": seeds, "joint_speed": joint_speed,
+        "commit": commit(), "measured": datetime.date.today().isoformat(), "wall_seconds": round(wall, 1),
+        "fit": summarise_fit(rows, kitchens, terms), "from_previous": summarise_fit(onward, kitchens, terms),
         "fetch": {"n": len(fetched), "mean_seconds": float(np.mean(fetched)) if fetched else 0.0,
                   "sd_seconds": float(np.std(fetched)) if fetched else 0.0},
     }
-    f = summary["fit"]
-    print(f"{len(rows)} pointing motions ({summary['reached']} reached) in {len(kitchens)} kitchens x "
+    print(f"{summary['n']} pointing motions ({summary['reached']} reached) in {len(kitchens)} kitchens x "
           f"{len(args.tasks)} tasks x {len(seeds)} scenes at {joint_speed:g} rad/s; {wall:.0f} s wall time")
-    print(f"seconds {seconds.min():.2f}-{seconds.max():.2f} (mean {seconds.mean():.2f}); distance "
-          f"{f['distance_range'][0]:.2f}-{f['distance_range'][1]:.2f} m, |bearing| "
-          f"{f['bearing_range'][0]:.2f}-{f['bearing_range'][1]:.2f} rad")
-    print("fit: " + " + ".join(f"{c:.3f}*{t}" for c, t in zip(coefficients, terms) if c > 0))
-    print(f"residual rms {f['rms']:.3f} s, max {f['max_abs']:.3f} s, R^2 {f['r2']:.3f}; "
-          f"leave-one-kitchen-out rms {held_rms:.3f} s")
+    _report("from rest", summary["fit"])
+    _report("from the previous object", summary["from_previous"])
     print(f"pantry fetch: {summary['fetch']['n']} fetches, mean {summary['fetch']['mean_seconds']:.2f} s "
           f"(sd {summary['fetch']['sd_seconds']:.2f})")
     if args.write:

@@ -154,3 +154,42 @@ def test_a_persons_clock_with_embodied_costs_counts_the_arms_simulated_seconds()
     plain.advance(3.0)
     embodied.advance(3.0)
     assert plain.now() == pytest.approx(5.0) and embodied.now() == pytest.approx(8.0)
+
+
+def test_pointing_from_the_last_object_depends_on_how_far_it_is_from_there():
+    costs = load_embodied_costs()
+    X = np.array([[0.0, 0.50, 0.0], [0.0, 0.52, 0.05], [0.0, 0.75, 1.2]])
+    rest = costs.pointing_seconds(X, RoomEnvironment.feature_names)
+    onward = costs.pointing_seconds(X, RoomEnvironment.feature_names, last=0)
+    assert onward[1] < onward[2] and onward[1] < rest[1]
+
+
+def test_the_learner_expects_pointing_from_where_the_arm_is():
+    from learning.actions import LabelQuery, NoQuery
+    from tests.dialog.fakes import ScriptedStrategy
+
+    config = EpisodeConfig(turns=20, budget=40, change_every=2, seed=2, seconds=600.0)
+    rngs = episode_generators(config.seed)
+    clock = VirtualClock()
+    costs = load_embodied_costs()
+    strategy = ScriptedStrategy([LabelQuery(2)] + [NoQuery()] * 19)
+    with TranscriptWriter(tmp_path_factory_dir() / "t.jsonl") as writer:
+        manager = DialogManager(RoomEnvironment(), ScriptedTeacher(rngs["teacher"], clock=clock), strategy, config,
+                                writer, rngs, say=lambda _: None, clock=clock)
+        manager.begin()
+        manager.play_turn()
+        scene = manager.scene
+        manager.play_turn()  # same scene: the arm still points at object 3
+        np.testing.assert_allclose(manager.state.seconds_clock.pointing,
+                                   costs.pointing_seconds(scene.X, scene.feature_names, last=2))
+        while manager.scene is scene:  # quiet 2 s turns until the next scene (every 2 nominal turns of 10 s)
+            manager.play_turn()
+        np.testing.assert_allclose(manager.state.seconds_clock.pointing,
+                                   costs.pointing_seconds(manager.scene.X, manager.scene.feature_names))
+
+
+def tmp_path_factory_dir():
+    import tempfile
+    from pathlib import Path
+
+    return Path(tempfile.mkdtemp())
