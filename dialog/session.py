@@ -22,7 +22,9 @@ from dialog.transcript import VERSION, TranscriptWriter, read_numbered_session
 from dialog.user_weights import weights_from_header
 from learning.actions import DEFAULT_COSTS
 from learning.errors import DataFileError, SettingsError, TranscriptError
+from learning.rl.policy_file import policy_digest
 from learning.strategies import STRATEGY_NAMES
+from learning.strategies.rl_questioner import PREFIX as RL_PREFIX
 
 TEACHERS = ("terminal", "scripted", "replay")  # the kinds a teach session records
 
@@ -79,8 +81,10 @@ def check_header(header: dict, path) -> None:
     for name, folder in (("task", "tasks"), ("kitchen", "kitchens")):
         if not _known_data_file(folder, header[name]):
             raise refuse(name, f"one of {', '.join(available(folder))}")
-    if header["strategy"] not in STRATEGY_NAMES:
-        raise refuse("strategy", f"one of {', '.join(STRATEGY_NAMES)}")
+    if isinstance(header["strategy"], str) and header["strategy"].startswith(RL_PREFIX):
+        _check_policy(header, path, refuse)
+    elif header["strategy"] not in STRATEGY_NAMES:
+        raise refuse("strategy", f"one of {', '.join(STRATEGY_NAMES)}, or {RL_PREFIX}FILE")
     if not (_is_int(header["seed"]) and header["seed"] >= 0):
         raise refuse("seed", "a whole number of 0 or more")
     for name in ("turns", "change_every"):
@@ -107,6 +111,21 @@ def check_header(header: dict, path) -> None:
         raise refuse("features", "the number of features, at least 1")
     _check_teacher(header.get("teacher", {"kind": "terminal"}), refuse)
     weights_from_header(header.get("weights"), path)
+
+
+def _check_policy(header: dict, path, refuse) -> None:
+    """A trained questioner's session resumes only with the very policy file it was recorded with."""
+    recorded, file = header.get("policy"), header["strategy"][len(RL_PREFIX):]
+    if not (isinstance(recorded, dict) and recorded.get("file") == file and isinstance(recorded.get("sha256"), str)):
+        raise refuse("policy", f"the file {file} and its SHA-256, as teachbot records them for {header['strategy']}")
+    try:
+        now = policy_digest(file)
+    except OSError:
+        raise TranscriptError(f"{path}: the session was recorded with the questioner policy {file}, which can't be "
+                              "read now; restore that file to resume") from None
+    if now != recorded["sha256"]:
+        raise TranscriptError(f"{path}: the questioner policy {file} changed since the session was recorded; restore "
+                              "it, or start a new session without --resume")
 
 
 def _check_teacher(teacher, refuse) -> None:

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import re
 import textwrap
+from pathlib import Path
 
 from bullet_world.datafiles import available
 from dialog.settings import DEFAULTS, EpisodeSettings
@@ -149,6 +150,18 @@ def positive_seconds(text: str) -> float:
     return value
 
 
+def strategy_choice(strategies):
+    """An argparse type: one of ``strategies``, or ``rl:FILE`` (the file made absolute, so a resume finds it)."""
+    def parse(text: str) -> str:
+        if text.startswith("rl:") and len(text) > 3:
+            return "rl:" + str(Path(text[3:]).resolve())
+        if text in strategies:
+            return text
+        raise argparse.ArgumentTypeError(f"'{text}' is not one of the accepted names: {', '.join(strategies)}, or "
+                                         "rl:FILE (a trained questioner policy .toml)")
+    return parse
+
+
 def add_episode_options(parser: argparse.ArgumentParser, strategies, default_strategy: str,
                         defaults: EpisodeSettings = DEFAULTS) -> None:
     """--seed --turns --budget --change-every --strategy --task --kitchen, their defaults read from ``defaults``."""
@@ -160,8 +173,9 @@ def add_episode_options(parser: argparse.ArgumentParser, strategies, default_str
                         help=f"question budget B in cost units (default {defaults.budget:g})")
     parser.add_argument("--change-every", type=positive_int, default=defaults.change_every,
                         help=f"a new scene every r turns (default {defaults.change_every})")
-    parser.add_argument("--strategy", default=default_strategy, choices=strategies,
-                        help=f"questioning strategy (default {default_strategy})")
+    parser.add_argument("--strategy", default=default_strategy, type=strategy_choice(strategies), metavar="STRATEGY",
+                        help=f"questioning strategy: {', '.join(strategies)}, or rl:FILE (a questioner policy from "
+                             f"teachbot train-questioner) (default {default_strategy})")
     add_task_option(parser, defaults.task)
     add_kitchen_option(parser, defaults.kitchen)
 

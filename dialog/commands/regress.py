@@ -33,7 +33,9 @@ def register(commands) -> None:
                     "with the stored baseline (--check exits 1 on a regression).")
     parser.add_argument("--suite", required=True, help=f"suite name ({', '.join(suite_names())}) or a .toml path")
     parser.add_argument("--results", type=Path, default=None, help="results folder (default results/<suite>)")
-    parser.add_argument("--strategies", nargs="+", default=None, help="run only these strategies")
+    parser.add_argument("--strategies", nargs="+", default=None,
+                        help="run only these strategies; rl:FILE adds a trained questioner policy "
+                             "(teachbot train-questioner)")
     parser.add_argument("--seeds", nargs="+", type=seeds, default=None, help="override the suite's seeds")
     parser.add_argument("--budget", type=budget, default=None, help="override every condition's budget")
     parser.add_argument("--datasets", type=positive_int, default=None, help="override the number of data sets")
