@@ -75,3 +75,22 @@ class ScriptedStrategy:
         action = self.actions[self.calls] if self.calls < len(self.actions) else NoQuery()
         self.calls += 1
         return Decision(action, f"step {self.calls} of my script")
+
+
+class QuittingTeacher:
+    """A scripted teacher that says "quit" at turn ``quit_at`` (None: never), to test ending and resuming."""
+
+    def __init__(self, inner, quit_at=None):
+        self.inner, self.quit_at = inner, quit_at
+
+    def show(self, prompt):
+        pass
+
+    def listen(self, prompt, deadline):
+        return "quit" if prompt.turn == self.quit_at else self.inner.listen(prompt, deadline)
+
+    def tell(self, text):
+        pass
+
+    def fast_forward(self, prompt):
+        self.inner.fast_forward(prompt)

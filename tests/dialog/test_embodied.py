@@ -18,7 +18,7 @@ from dialog.manager import DialogManager, EpisodeConfig, episode_generators
 from dialog.teachers import ScriptedTeacher
 from dialog.transcript import TranscriptWriter, read_session, read_transcript
 from learning.errors import DataFileError, SettingsError
-from tests.dialog.fakes import FakeEnvironment
+from tests.dialog.fakes import FakeEnvironment, QuittingTeacher
 
 
 class RoomEnvironment(FakeEnvironment):
@@ -60,24 +60,12 @@ def embodied_run(tmp_path, name="t.jsonl", seconds=120.0, turns=200, strategy="d
     clock = VirtualClock()
     inner = ScriptedTeacher(rngs["teacher"], clock=clock, answer_delays=load_embodied_costs().answer)
 
-    class Quitter:
-        def show(self, prompt):
-            pass
-
-        def listen(self, prompt, deadline):
-            return "quit" if prompt.turn == quit_at else inner.listen(prompt, deadline)
-
-        def tell(self, text):
-            pass
-
-        def fast_forward(self, prompt):
-            inner.fast_forward(prompt)
-
     path, records = tmp_path / name, []
     if resume_from is not None:
         path, records = resume_from, read_session(resume_from, tolerate_partial_tail=True)[1]
     writer = TranscriptWriter(path, append=resume_from is not None)
-    manager = DialogManager(RoomEnvironment(), Quitter(), make_episode_strategy(strategy), config, writer, rngs,
+    teacher = QuittingTeacher(inner, quit_at)
+    manager = DialogManager(RoomEnvironment(), teacher, make_episode_strategy(strategy), config, writer, rngs,
                             say=lambda _: None, clock=clock)
     result = manager.run(replay=records)
     writer.close()

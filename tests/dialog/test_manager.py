@@ -9,7 +9,7 @@ from dialog.manager import DialogManager, EpisodeConfig, episode_generators
 from dialog.teachers import Answer, OracleTeacher
 from dialog.transcript import TranscriptWriter, read_transcript
 from learning.strategies import make_strategy
-from tests.dialog.fakes import FakeEnvironment
+from tests.dialog.fakes import FakeEnvironment, QuittingTeacher
 
 
 def run_episode(tmp_path, strategy="active", teacher=None, **config):
@@ -207,19 +207,6 @@ def run_full(tmp_path, name, quit_at=None, resume_from=None):
     env = PantryEnvironment(missing=("fruit",))
     inner = ScriptedTeacher(rngs["teacher"], mislabel_rate=0.2, dont_know_rate=0.1, answer_delay=2.0)
 
-    class Quitter:
-        def show(self, prompt):
-            pass
-
-        def listen(self, prompt, deadline):
-            return "quit" if prompt.turn == quit_at else inner.listen(prompt, deadline)
-
-        def tell(self, text):
-            pass
-
-        def fast_forward(self, prompt):
-            inner.fast_forward(prompt)
-
     inner.clock = clock = VirtualClock()
     actions = [FeatureQuery(), DemoQuery("fruit"), DemoQuery("snack")] + [LabelQuery(i % 8) for i in range(11)]
     path = tmp_path / name
@@ -228,8 +215,8 @@ def run_full(tmp_path, name, quit_at=None, resume_from=None):
         path = resume_from
         records = read_session(path, tolerate_partial_tail=True)[1]
     writer = TranscriptWriter(path, append=resume_from is not None)
-    manager = DialogManager(env, Quitter(), ScriptedStrategy(actions), config, writer, rngs, say=lambda _: None,
-                            clock=clock)
+    manager = DialogManager(env, QuittingTeacher(inner, quit_at), ScriptedStrategy(actions), config, writer, rngs,
+                            say=lambda _: None, clock=clock)
     result = manager.run(replay=records)
     writer.close()
     return result, path, env
