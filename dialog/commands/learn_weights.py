@@ -54,6 +54,9 @@ def register(commands) -> None:
                                  f"{VALIDATION_EPISODES})")
     trajectory.add_argument("--evaluate-every", type=positive_int, default=EVALUATE_EVERY, metavar="K",
                             help=f"score every K-th iterate and the last (default {EVALUATE_EVERY})")
+    trajectory.add_argument("--start", choices=("per-turn", "zero"), default="per-turn",
+                            help="iteration 0: the per-turn MaxEnt fit of the training demonstrations (default), or "
+                                 "w = 0 (the default before issue 15; the shipped dt-task-env weights)")
     trajectory.add_argument("--workers", type=positive_int, default=None,
                             help="local worker processes for the rollouts (default: cores)")
     trajectory.add_argument("--ray", metavar="ADDRESS", default=None,
@@ -98,6 +101,7 @@ def check_options(args: argparse.Namespace, method: str) -> None:
     given = {"trajectory": [("--validation", getattr(args, "validation", None) is not None),
                             ("--policy", getattr(args, "policy", "gated") != "gated")],
              "per-turn": [("--ray", getattr(args, "ray", None) is not None),
+                          ("--start", getattr(args, "start", "per-turn") != "per-turn"),
                           ("--workers", getattr(args, "workers", None) is not None)]}[method]
     wrong = [name for name, present in given if present]
     if wrong:
@@ -147,7 +151,7 @@ def learn_trajectory(args: argparse.Namespace, out):
     condition = training_condition()
     held_out = validation_seeds(args.validation_episodes)
     config = FeatureMatchingConfig(max_iterations=args.iterations, rollouts_per_iteration=args.rollouts,
-                                   seed=args.seed, evaluate_every=args.evaluate_every)
+                                   seed=args.seed, evaluate_every=args.evaluate_every, start=args.start)
     last_seed = training_seed(args.iterations, args.rollouts - 1, args.rollouts)
     context = {"commit": git_commit(), **condition.provenance(),
                "training_rollout_seeds": f"{training_seed(1, 0, args.rollouts)}-{last_seed}",

@@ -15,6 +15,11 @@ drawn from that policy with a generator seeded by (seed, iteration, rollout). Un
 per-turn fit in ``learning.irl.maxent`` this sees the states the learner's own
 choices lead to, at the price of simulating episodes every iteration.
 Counts are divided by the number of turns, so episodes of any length mix.
+
+The ascent starts (``start="per-turn"``, the default since issue 15) from the per-turn MaxEnt fit of the
+same expert episodes (``fit_maxent_irl`` with the softmax policy: eq. 7.5 maximised as the
+log-likelihood of the expert's choices, which the thesis states L_ME is equal to); that start is
+iteration 0 and a candidate for the kept iterate. ``start="zero"`` begins at w = 0 (the earlier default).
 """
 
 from __future__ import annotations
@@ -29,11 +34,13 @@ import torch
 from learning.irl.demonstrations import QuestioningEpisode
 from learning.irl.maxent import (
     AdamAscent,
+    IrlConfig,
     IrlResult,
     IterationRecord,
     PaddedTurns,
     compute_threads,
     feature_scale,
+    fit_maxent_irl,
     log_likelihood,
     make_result,
 )
@@ -44,6 +51,9 @@ Rollout = Callable[[np.ndarray, np.random.Generator], QuestioningEpisode]  # one
 RolloutBatch = Callable[[np.ndarray, int, int], Sequence[QuestioningEpisode]]
 Evaluate = Callable[[np.ndarray], float]  # a score of weights on held-out episodes, higher is better
 Progress = Callable[[IterationRecord, float], None]  # (this iteration's record, seconds since the start)
+
+
+STARTS = ("per-turn", "zero")
 
 
 @dataclass(frozen=True)
@@ -60,6 +70,7 @@ class FeatureMatchingConfig:
     evaluate_every: int = 1  # with ``evaluate``: score every k-th iterate (and the last)
     optimizer: str = "adam"  # or "gradient": plain ascent along the gap, x += learning_rate * gap
     expected_counts: bool = True  # learner's counts: the policy's expectation at each visited state (else sampled)
+    start: str = "per-turn"  # iteration 0: the per-turn MaxEnt fit of the expert episodes, or "zero" (w = 0)
 
     def __post_init__(self) -> None:
         for name in ("max_iterations", "rollouts_per_iteration", "evaluate_every"):
@@ -74,6 +85,8 @@ class FeatureMatchingConfig:
             raise ValueError(f"threads must be an integer >= 1, got {self.threads!r}")
         if self.learning_rate == 0:
             raise ValueError("learning_rate must be > 0")
+        if self.start not in STARTS:
+            raise ValueError(f"start must be one of {', '.join(STARTS)}, got {self.start!r}")
 
 
 def rollout_generator(seed: int, iteration: int, index: int) -> np.random.Generator:
@@ -112,7 +125,9 @@ def fit_feature_matching(expert: Sequence[QuestioningEpisode], rollouts: Rollout
                          progress: Progress | None = None) -> IrlResult:
     """Learn w so that the learner's rollouts match the expert's feature counts (eq. 7.6, 7.7).
 
-    Each iteration plays ``rollouts_per_iteration`` episodes with the current
+    Iteration 0 is ``initial_weights`` if given, else the per-turn MaxEnt fit of ``expert``
+    (with ``validation`` choosing its iterate; ``config.start="per-turn"``) or w = 0
+    (``start="zero"``). Each iteration plays ``rollouts_per_iteration`` episodes with the current
     weights (``rollouts(w, iteration, count)``). With ``evaluate`` the kept
     weights are the evaluated iterate with the highest score (the thesis: the
     best on held-out validation episodes), ties to the higher agreement with the
@@ -137,7 +152,16 @@ def _fit_feature_matching(expert, rollouts: RolloutBatch, validation, config: Fe
                          f"episodes {list(names)}; they must match")
     scale, identifiable = feature_scale(train_turns, config.standardize)
     expert_counts = mean_feature_counts(expert) / scale
-    w0 = np.zeros(len(names)) if initial_weights is None else np.asarray(initial_weights, dtype=np.float64)
+    if initial_weights is not None:
+        w0, start = np.asarray(initial_weights, dtype=np.float64), "given"
+    elif config.start == "per-turn":  # eq. 7.5 as the expert's log-likelihood, on the expert's own turns
+        per_turn_config = IrlConfig(policy="softmax", seed=config.seed, threads=config.threads)
+        per_turn = fit_maxent_irl(expert, validation, per_turn_config)
+        w0 = per_turn.weights.values
+        start = (f"per-turn MaxEnt fit (softmax, l2 {per_turn_config.l2:g}, kept iteration "
+                 f"{per_turn.best_iteration})")
+    else:
+        w0, start = np.zeros(len(names)), "zero"
     if w0.shape != (len(names),) or not np.all(np.isfinite(w0)):
         raise ValueError(f"initial_weights must be {len(names)} finite numbers, got shape {w0.shape}")
     adam, x = AdamAscent(config.learning_rate), w0 * scale
@@ -186,6 +210,7 @@ def _fit_feature_matching(expert, rollouts: RolloutBatch, validation, config: Fe
                 "learning_rate": float(config.learning_rate),
                 "rollouts_per_iteration": config.rollouts_per_iteration,
                 "learner_counts": "expected under the policy" if config.expected_counts else "sampled",
+                "start": start,
                 "select_by": "evaluation" if evaluate is not None else "agreement"}
     if evaluate is not None:
         settings["evaluate_every"] = config.evaluate_every

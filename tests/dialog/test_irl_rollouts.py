@@ -106,6 +106,7 @@ def test_learn_weights_by_trajectory_on_the_real_loop_writes_weights_with_proven
     assert p["held_out_log_likelihood"] < 0 and p["demonstrations"].endswith(".json")
     assert p["commit"] == "unknown" or len(p["commit"]) == 40
     assert "selection" not in p and "validation seeds" in p["select_by"]
+    assert p["start"].startswith("per-turn MaxEnt fit")  # the default since issue 15 (the shipped file: w = 0)
 
 
 def test_options_of_the_other_method_are_refused(tmp_path, capsys):
@@ -114,5 +115,7 @@ def test_options_of_the_other_method_are_refused(tmp_path, capsys):
     assert "--policy do(es) not apply to --method trajectory" in capsys.readouterr().err
     assert main(["learn-weights", "--demos", "shipped", "--out", out, "--method", "per-turn", "--ray", "local"]) == 2
     assert "--ray do(es) not apply to --method per-turn" in capsys.readouterr().err
+    assert main(["learn-weights", "--demos", "shipped", "--out", out, "--method", "per-turn", "--start", "zero"]) == 2
+    assert "--start do(es) not apply to --method per-turn" in capsys.readouterr().err
     assert main(["learn-weights", "--demos", "shipped", "--out", out, "--train-episodes", "999"]) == 2
     assert "--train-episodes must be in 1.." in capsys.readouterr().err  # before any rollout is played

@@ -221,10 +221,10 @@ def test_feature_matching_with_rollouts_learns_the_policy(dt_expert):
     def rollout(weights, rng):
         return TASK.episode(softmax_policy(weights), rng)
 
-    config = FeatureMatchingConfig(max_iterations=40, rollouts_per_iteration=2, seed=3)
+    config = FeatureMatchingConfig(max_iterations=40, rollouts_per_iteration=2, seed=3, start="zero")
     result = fit_feature_matching(train, serial_rollouts(rollout, seed=3), validation, config)
     assert result.iterations == 40 and len(result.history) == 41
-    # the mechanics on ten episodes and 40 iterations; the recovery target is in test_irl_trajectory.py
+    # the mechanics from w = 0 on ten episodes and 40 iterations; the recovery target is in test_irl_trajectory.py
     assert agreement(test, result.weights.values) >= 0.75 > 0.5 > agreement(test, np.zeros(7))
     assert cosine(result.weights.values, TRUE_WEIGHTS) > 0.7
     gaps = [record.loss for record in result.history[1:]]

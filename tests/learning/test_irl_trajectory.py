@@ -35,13 +35,34 @@ def expert():
 
 
 def test_trajectory_irl_recovers_known_weights_on_held_out_synthetic_episodes(expert):
+    """Three expert episodes, as the thesis; the default start is the per-turn MaxEnt fit (docs/irl.md: the sweep)."""
     train, validation, test = expert
     config = FeatureMatchingConfig(max_iterations=100, rollouts_per_iteration=4, seed=0)
     result = fit_feature_matching(train, serial_rollouts(learner_rollout, seed=0), validation, config)
     held_out = agreement(test, result.weights.values)
-    assert held_out >= 0.85, f"held-out agreement {held_out:.3f}"  # measured 0.873 (the brief asked 0.9)
+    assert held_out >= 0.9, f"held-out agreement {held_out:.3f}"  # measured 0.958; 25 fits: 0.916-0.987
     assert agreement(test, np.zeros(7)) < 0.5  # the expert is not "always stay quiet"
     assert result.weights.provenance["learner_counts"] == "expected under the policy"
+    assert result.weights.provenance["start"].startswith("per-turn MaxEnt fit (softmax")
+    assert len(result.history) == 101  # iteration 0 (the start) and 100 rollout iterations
+
+
+def test_the_start_of_the_ascent(expert):
+    """start="zero" is the earlier default (w = 0); given initial weights win over either start."""
+    train, validation, _ = expert
+    zero = fit_feature_matching(train, serial_rollouts(learner_rollout), validation,
+                                FeatureMatchingConfig(max_iterations=1, rollouts_per_iteration=1, start="zero"),
+                                evaluate=lambda w: -float(np.abs(w).sum()))  # keeps iteration 0
+    assert zero.best_iteration == 0 and not np.any(zero.weights.values)
+    assert zero.weights.provenance["start"] == "zero"
+    given = fit_feature_matching(train, serial_rollouts(learner_rollout), validation,
+                                 FeatureMatchingConfig(max_iterations=1, rollouts_per_iteration=1),
+                                 initial_weights=TRUE_WEIGHTS,
+                                 evaluate=lambda w: -float(np.abs(w - TRUE_WEIGHTS).sum()))
+    assert given.weights.provenance["start"] == "given"
+    np.testing.assert_array_equal(given.weights.values, TRUE_WEIGHTS)
+    with pytest.raises(ValueError, match="start must be one of per-turn, zero"):
+        FeatureMatchingConfig(start="random")
 
 
 def test_the_evaluated_iterate_with_the_best_score_is_kept(expert):
