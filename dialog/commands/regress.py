@@ -74,7 +74,7 @@ def run(args: argparse.Namespace) -> int:
                                               datasets=args.datasets, data_seed=args.data_seed,
                                               embodied_seconds=_embodied_seconds(args)))
     if args.update_baseline:
-        refuse_baseline_from_another_run(suite, original.data_seed)  # before anything runs
+        refuse_baseline_from_another_run(suite, original)  # before anything runs
     if args.check:
         refuse_other_data_seed(suite)  # before anything runs
         if args.embodied_costs:

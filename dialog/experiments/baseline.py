@@ -51,17 +51,26 @@ def refuse_other_data_seed(suite: Suite, path: Path | None = None) -> None:
                          f"uses data seed {suite.data_seed}; check with --data-seed {stored}, or run without --check")
 
 
-def refuse_baseline_from_another_run(suite: Suite, own_data_seed: int) -> None:
+def refuse_baseline_from_another_run(suite: Suite, original: Suite) -> None:
     """``--update-baseline`` stores only the suite's own run: refuse (SettingsError, before anything runs) a run
-    that adds --weights strategies or uses data sets of another seed than the suite's ``own_data_seed``."""
+    that adds --weights strategies or trained policies, uses data sets of another seed than the suite file's
+    (``original``, as loaded), or changes its strategies, seeds, conditions or data sets on the command line."""
     if suite.weights:
         raise SettingsError(f"--update-baseline stores the suite's own run as the baseline of '{suite.name}'; this run "
                             f"adds --weights strategies ({', '.join(suite.weights)}): run it without "
                             "--update-baseline, or store the baseline without --weights")
-    if suite.data_seed != own_data_seed:
+    if suite.data_seed != original.data_seed:
         raise SettingsError(f"--update-baseline stores the suite's own run as the baseline of '{suite.name}', made on "
-                            f"the data sets of data seed {own_data_seed}; this run uses data seed {suite.data_seed}: "
-                            "run it without --update-baseline, or store the baseline without --data-seed")
+                            f"the data sets of data seed {original.data_seed}; this run uses data seed "
+                            f"{suite.data_seed}: run it without --update-baseline, or store the baseline without "
+                            "--data-seed")
+    changed = [option for option, field in (("--strategies", "strategies"), ("--seeds", "seeds"),
+                                            ("--budget or --embodied-costs", "conditions"), ("--datasets", "datasets"))
+               if getattr(suite, field) != getattr(original, field)]
+    if changed:
+        raise SettingsError(f"--update-baseline stores the suite's own run as the baseline of '{suite.name}'; this run "
+                            f"changes the suite with {', '.join(changed)}: run it without --update-baseline, or "
+                            "store the baseline without those options (or edit the suite file)")
 
 
 def check_against_baseline(suite: Suite, summaries: list[CheckpointSummary], path: Path | None = None) -> list[str]:

@@ -234,13 +234,17 @@ def test_regress_update_baseline_with_a_run_not_the_suite_s_own_is_refused_befor
 
 def test_update_baseline_accepts_the_suite_s_own_data_seed_and_refuses_others(tmp_path):
     suite = load_suite(_suite_file_text(tmp_path, "data_seed = 3\n" + TINY))
-    refuse_baseline_from_another_run(suite, suite.data_seed)  # the suite's own run: fine
-    refuse_baseline_from_another_run(suite.with_overrides(data_seed=3), suite.data_seed)  # --data-seed 3 is its own
+    refuse_baseline_from_another_run(suite, suite)  # the suite's own run: fine
+    refuse_baseline_from_another_run(suite.with_overrides(data_seed=3), suite)  # --data-seed 3 is its own
     with pytest.raises(SettingsError, match="made on the data sets of data seed 3; this run uses data seed 0"):
-        refuse_baseline_from_another_run(suite.with_overrides(data_seed=0), suite.data_seed)
+        refuse_baseline_from_another_run(suite.with_overrides(data_seed=0), suite)
     weighted = suite.with_weights(read_named_weights([("mine", _weights_file(tmp_path))]))
     with pytest.raises(SettingsError, match=r"adds --weights strategies \(mine\)"):
-        refuse_baseline_from_another_run(weighted, suite.data_seed)
+        refuse_baseline_from_another_run(weighted, suite)
+    for overrides, option in (({"seeds": [7]}, "--seeds"), ({"budget": 5.0}, "--budget"),
+                              ({"datasets": 2}, "--datasets"), ({"strategies": ["active"]}, "--strategies")):
+        with pytest.raises(SettingsError, match=f"changes the suite with {option}"):
+            refuse_baseline_from_another_run(suite.with_overrides(**overrides), suite)
 
 
 def test_regress_weights_errors_are_one_line(tmp_path, capsys):
