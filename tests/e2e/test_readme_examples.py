@@ -32,6 +32,9 @@ SKIPPED = {
     "teachbot regress --suite recipes": "runs long (2,040 recipe trials)",
     "teachbot learn-weights --demos shipped --out w.toml --json":
         "runs long (trajectory IRL: 100 iterations of dialog rollouts, about 10 minutes on 2 cores)",
+    "teachbot train-questioner --out questioner.toml":
+        "runs long (20,000 steps of masked PPO, about 30 minutes on 2 cores; tests/dialog/test_rl_training.py "
+        "trains for 256)",
     "teachbot regress --suite ch7 --strategies active dt-task --seeds 0 1 --ray local":
         "the chapter-7 suite is run by the lead only; long, and starts a Ray cluster",
 }
@@ -68,11 +71,13 @@ def test_the_readme_has_examples_and_every_skip_names_one_of_them():
 @pytest.mark.parametrize("command", [c for c in COMMANDS if c not in SKIPPED])
 def test_a_readme_example_runs_as_written(command, tmp_path):
     argv = [str(TEACHBOT), *shlex.split(command)[1:]]
-    for argument in argv[1:]:  # a file of the clone the example names (a study file) is copied beside it
-        source = README.parent / argument
-        if not argument.startswith("-") and "/" in argument and source.is_file():
-            (tmp_path / argument).parent.mkdir(parents=True, exist_ok=True)
-            shutil.copy(source, tmp_path / argument)
+    for argument in argv[1:]:  # a file of the clone the example names (a study file, rl:POLICY) is copied beside it
+        name = argument.removeprefix("rl:")
+        source = README.parent / name
+        if not name.startswith("-") and "/" in name and source.is_file():
+            (tmp_path / name).parent.mkdir(parents=True, exist_ok=True)
+            for part in (source, source.with_suffix(".npz")) if argument.startswith("rl:") else (source,):
+                shutil.copy(part, tmp_path / Path(name).with_suffix(part.suffix))
     result = subprocess.run(argv, cwd=tmp_path, capture_output=True, text=True, timeout=TIMEOUT_S,
                             stdin=subprocess.DEVNULL, check=False)
     assert result.returncode == 0, f"{command} exited {result.returncode}:\n{result.stderr[-2000:]}"
