@@ -90,3 +90,13 @@ def test_a_missing_policy_is_one_line(tmp_path, capsys):
     with pytest.raises(SystemExit) as exited:  # argparse's own exit, in the tool's voice
         main(["demo", "--strategy", "nonsense"])
     assert exited.value.code == 2 and "or rl:FILE" in capsys.readouterr().err
+
+
+def test_a_bad_out_path_is_one_line_before_any_training(tmp_path, capsys):
+    assert main(["train-questioner", "--out", str(tmp_path / "q.json")]) == 2
+    assert "must end in .toml" in capsys.readouterr().err
+    blocker = tmp_path / "file"
+    blocker.write_text("")
+    assert main(["train-questioner", "--out", str(blocker / "q.toml")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and "Traceback" not in err and str(blocker) in err
