@@ -10,6 +10,7 @@ import numpy as np
 from dialog.experiments.analysis import CheckpointSummary
 from dialog.experiments.suite import SUITE_DIR, Suite, SuiteError
 from learning.errors import SettingsError
+from learning.strategies.rl_questioner import PREFIX as RL_PREFIX
 
 BASELINE_DIR = SUITE_DIR / "baselines"
 DEFAULT_TOLERANCE = 0.05
@@ -90,7 +91,7 @@ def check_against_baseline(suite: Suite, summaries: list[CheckpointSummary], pat
     failures = []
     for s in summaries:
         stored = bands.get(s.condition, {}).get(s.strategy)
-        if stored is None and (s.strategy in suite.weights or s.strategy.startswith("rl:")):
+        if stored is None and (s.strategy in suite.weights or s.strategy.startswith(RL_PREFIX)):
             continue  # a --weights strategy or a trained policy: the user's own, no baseline to hold it to
         if stored is None:
             failures.append(f"{s.strategy}/{s.condition}: not in the baseline")

@@ -150,7 +150,6 @@ def train(config: TrainingConfig, progress: bool = True, provenance: dict | None
     record = {**(provenance or {}), **{f"ppo_{k}": v for k, v in asdict(config).items() if k != "env"},
               **{f"env_{k}": _plain(v) for k, v in probe.settings.__dict__.items()},
               "algorithm": "MaskablePPO (sb3-contrib)", "hidden_layers": list(HIDDEN), **summary}
-    record["final_accuracy_last_50"] = summary["final_accuracy_last_50"] if recent else -1.0
     return actor_policy(model, layout, record), summary
 
 

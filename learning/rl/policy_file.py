@@ -79,10 +79,13 @@ class QuestionerPolicy:
                 h = act(h)
         return h
 
+    def masked_logits(self, observation: np.ndarray, mask: np.ndarray) -> np.ndarray:
+        """The logits with every slot the mask closes at -inf."""
+        return np.where(np.asarray(mask, dtype=bool), self.logits(observation), -np.inf)
+
     def best_slot(self, observation: np.ndarray, mask: np.ndarray) -> int:
         """The allowed slot with the highest logit (ties to the lower slot: no query first)."""
-        logits = np.where(np.asarray(mask, dtype=bool), self.logits(observation), -np.inf)
-        return int(np.argmax(logits))
+        return int(np.argmax(self.masked_logits(observation, mask)))
 
 
 def policy_digest(path: str | Path) -> str:

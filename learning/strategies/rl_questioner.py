@@ -45,12 +45,11 @@ class RLQuestionerStrategy(Strategy):
         observation = self.policy.layout.encode(state, self.engine)
         if observation.mask.sum() == 1:  # only no query is left
             return self.nothing_affordable(state)
-        logits = self.policy.logits(observation.vector)
-        slot = self.policy.best_slot(observation.vector, observation.mask)
+        logits = self.policy.masked_logits(observation.vector, observation.mask)
+        slot = int(np.argmax(logits))  # the allowed slot with the highest logit, ties to no query
         action = observation.actions[slot]
         assert action is not None, "the best slot is always an allowed one"
-        allowed = logits[observation.mask]
-        margin = float(logits[slot] - np.sort(allowed)[-2]) if len(allowed) > 1 else 0.0
+        margin = float(logits[slot] - np.sort(logits)[-2])  # at least two slots are open here
         if action.kind == "none":
             return Decision(action, f"Nothing to ask: my trained policy prefers to stay quiet now (logit margin "
                                     f"{margin:.2f} over its best question).")
