@@ -9,6 +9,7 @@ from pathlib import Path
 
 from bullet_world.datafiles import available
 from dialog.settings import DEFAULTS, EpisodeSettings
+from learning.strategies.rl_questioner import PREFIX as RL_PREFIX
 
 
 class HelpFormatter(argparse.HelpFormatter):
@@ -137,6 +138,13 @@ def add_kitchen_option(parser: argparse.ArgumentParser, default: str | None, def
                              f"(default {default_text or default})", **extra)
 
 
+def add_scene_options(parser: argparse.ArgumentParser) -> None:
+    """``--task``, ``--kitchen`` and ``--seed`` of one scene, as demo's first scene (view, world show)."""
+    add_task_option(parser, "pack-lunchbox")
+    add_kitchen_option(parser, "kitchen-1")
+    parser.add_argument("--seed", type=seed, default=0, help="seed of the scene (default 0)")
+
+
 positive_int = _at_least(int, "a whole number", 1, "expected a whole number of at least 1, got {value}")
 budget = _at_least(float, "a number of cost units", 0, "the budget can't be negative, got {value:g}")
 price = _at_least(float, "a number", 0, "the price can't be negative, got {value:g}")
@@ -153,8 +161,8 @@ def positive_seconds(text: str) -> float:
 def strategy_choice(strategies):
     """An argparse type: one of ``strategies``, or ``rl:FILE`` (the file made absolute, so a resume finds it)."""
     def parse(text: str) -> str:
-        if text.startswith("rl:") and len(text) > 3:
-            return "rl:" + str(Path(text[3:]).resolve())
+        if text.startswith(RL_PREFIX) and len(text) > len(RL_PREFIX):
+            return RL_PREFIX + str(Path(text[len(RL_PREFIX):]).resolve())
         if text in strategies:
             return text
         raise argparse.ArgumentTypeError(f"'{text}' is not one of the accepted names: {', '.join(strategies)}, or "

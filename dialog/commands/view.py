@@ -15,7 +15,7 @@ import sys
 import time
 from pathlib import Path
 
-from dialog.commands._arguments import add_kitchen_option, add_task_option, positive_int, seconds, seed
+from dialog.commands._arguments import add_scene_options, positive_int, seconds
 from learning.errors import SettingsError
 
 
@@ -25,9 +25,7 @@ def register(commands) -> None:
         description="Mirror the first scene that 'teachbot demo' shows for the same task, kitchen and seed into "
                     "meshcat and print its URL; --point N lets the arm point at object N as a label question does. "
                     "--export and --screenshot write their file and exit unless --serve is given.")
-    add_task_option(parser, "pack-lunchbox")
-    add_kitchen_option(parser, "kitchen-1")
-    parser.add_argument("--seed", type=seed, default=0, help="seed of the scene (default 0)")
+    add_scene_options(parser)
     parser.add_argument("--point", type=positive_int, default=None, metavar="N",
                         help="let the arm point at object N and ask about it, as a label question does")
     parser.add_argument("--export", type=Path, default=None, metavar="HTML",

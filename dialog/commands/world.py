@@ -8,7 +8,14 @@ import json
 import sys
 from pathlib import Path
 
-from dialog.commands._arguments import add_kitchen_option, add_task_option, kitchen_names, positive_int, seed
+from dialog.commands._arguments import (
+    add_kitchen_option,
+    add_scene_options,
+    add_task_option,
+    kitchen_names,
+    positive_int,
+    seed,
+)
 from learning.errors import SettingsError
 
 
@@ -25,9 +32,7 @@ def register(commands) -> None:
         description="The first scene that 'teachbot demo' and 'teachbot view' show for the same task, kitchen and "
                     "seed, as a table: object number, kind and concept, colour, size, location. --png also writes "
                     "the annotated camera picture.")
-    add_kitchen_option(show, "kitchen-1")
-    add_task_option(show, "pack-lunchbox")
-    show.add_argument("--seed", type=seed, default=0, help="seed of the scene (default 0)")
+    add_scene_options(show)
     show.add_argument("--objects", type=positive_int, default=None,
                       help="objects in the scene (default: the task's objects_per_scene)")
     show.add_argument("--stage", type=int, default=None,
