@@ -76,7 +76,8 @@ def assert_interrupted_cleanly(code: int, output: str) -> None:
 def test_ctrl_c_at_any_moment_of_teach_and_demo(tmp_path, delay_s):
     commands = {
         "teach": ["teach", "--teacher", "scripted", "--turns", "200", "--transcript", tmp_path / "teach.jsonl"],
-        "demo": ["demo", "--viewer", "--transcript", tmp_path / "demo.jsonl"],
+        # 200 turns, as teach: the 30-turn default can end (2.2 s on an idle machine) before the latest signal
+        "demo": ["demo", "--viewer", "--turns", "200", "--transcript", tmp_path / "demo.jsonl"],
     }
     for name, args in commands.items():
         process = start(*args, cwd=tmp_path)
