@@ -197,6 +197,21 @@ class AnswerParser:
                         best[concept] = distance
         return best
 
+    def _typo_of_whole_line(self, pieces: list[Token]) -> Reading | None:
+        """The one concept whose whole name the line's words are a typo of ("main dsh" -> main dish), else None."""
+        words = [t for t in pieces if not (t.kind == "word" and t.text in self.vocabulary.fillers)]
+        content = " ".join(t.text for t in words)
+        if not words or not all(t.kind == "word" for t in words) or len(content) > 60:
+            return None
+        best = self._fuzzy([content])
+        if not best:
+            return None
+        top = min(best.values())
+        close = [c for c in self.concepts if c in best and best[c] <= top + 1]
+        if len(close) == 1 and top <= typo_tolerance(phrase(close[0])):
+            return Reading("answer", close[0], message=f"(I take '{content}' as '{close[0]}'.)")
+        return None
+
     # -- label queries ----------------------------------------------------------------
     def label(self, text: str) -> Reading:
         """A concept name for a label query ("a fruit", "Fruits", "frut", "3" from the numbered list)."""
@@ -212,6 +227,10 @@ class AnswerParser:
             return Reading("unreadable", message=f"I can only learn what it is, not what it isn't. {accepted}")
         named, leftover = self._segment(pieces)
         mentioned = tuple(c for c in self.concepts if any(c in owners for owners in named))
+        if leftover:  # "main dihs": a synonym ("main") took one word of a mistyped two-word name
+            whole = self._typo_of_whole_line(pieces)
+            if whole:
+                return whole
         if mentioned:
             if len(mentioned) == 1 and not leftover:
                 return Reading("answer", mentioned[0])
@@ -267,7 +286,8 @@ class AnswerParser:
             return Reading("unreadable", message=f"Please tell me which one it is, not which it isn't. {accepted}")
         distinct = sorted({n for n, _ in numbers})
         if len(distinct) > 1:
-            return Reading("unreadable", message=f"One number please, you gave {distinct[:5]}. {accepted}")
+            written = list(dict.fromkeys(token.text for _, token in numbers))  # as typed, in the order typed
+            return Reading("unreadable", message=f"One number please, you gave {_quoted(written)}. {accepted}")
         if leftover:
             return Reading("unreadable", message=f"{_not_understood(clean(text)[:60], leftover)} {accepted}")
         if numbers and absent:

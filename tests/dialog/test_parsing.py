@@ -160,3 +160,21 @@ def test_confirmations_are_read_by_the_same_grammar(parser):
     for text in ("2 <b>", "-1", "3", "fruit xyz", "%s", "fruit and snack"):
         reading = parser.choice(text, choices)
         assert reading.kind == "unreadable" and reading.message.endswith(parser.choice_forms(choices))
+
+
+@pytest.mark.parametrize("text", ["main dihs", "main dsh", "mian dish", "the main dihs please", "Main Dsh!"])
+def test_typos_of_a_two_word_concept_are_matched_on_the_whole_name(parser, text):
+    """'main' is a synonym of main dish, so the mistyped second word used to be left over and refused."""
+    reading = parser.label(text)
+    assert (reading.kind, reading.value) == ("answer", "main dish")
+    assert "as 'main dish'" in reading.message
+
+
+@pytest.mark.parametrize("text", ["main xyzzy", "main fruit salad", "fruit snak"])
+def test_a_synonym_beside_an_unrelated_word_is_still_not_guessed(parser, text):
+    assert parser.label(text).kind in ("unreadable", "choose")
+
+
+def test_several_numbers_are_said_back_as_written():
+    reading = AnswerParser(CONCEPTS).demonstration("10 or 5", 12, "fruit")
+    assert "you gave '10' and '5'." in reading.message and "[" not in reading.message
