@@ -93,8 +93,8 @@ class TerminalTeacher:
             if dropped:
                 self.say(f"(ignored {dropped} line(s) typed after the time ran out)")
             self._missed = False
-        if prompt is self._shown and prompt.expects == "feature":
-            return  # its list is still on screen, and "Taken back: ..." repeated the question
+        if prompt is self._shown:
+            return  # asked again after an undo: "Taken back: ..." already repeated the question
         self._shown = prompt
         self.console.print()
         status = f"Turn {prompt.turn} of {prompt.turns} · budget left {prompt.budget_left:g}"

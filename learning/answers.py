@@ -37,6 +37,7 @@ class Change:
     features: tuple[int, ...] | None = None
     previous_subsets: dict | None = field(default=None, compare=False, repr=False)
     example: Example | None = field(default=None, compare=False, repr=False)  # the row an "example" added
+    cost: float = field(default=0.0, compare=False)  # the budget the answer's turn was charged (refunded by undo)
 
 
 @dataclass(frozen=True)

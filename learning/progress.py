@@ -75,6 +75,12 @@ class Progress:
                        feature_query_asked=self.feature_query_asked or action.kind == "feature",
                        last_query_scene_id=scene_id if asked else self.last_query_scene_id)
 
+    def refunded(self, cost: float, reopen_feature_query: bool) -> Progress:
+        """The progress once a taken-back answer's ``cost`` is given back (the turn itself stays over); a taken-back
+        feature answer also re-opens the feature question, which may be asked once (thesis §6.3)."""
+        return replace(self, spent=max(0.0, self.spent - cost),
+                       feature_query_asked=self.feature_query_asked and not reopen_feature_query)
+
     def placed(self, **fields) -> Progress:
         """This progress with some fields set (a state part-way through an episode); checked first."""
         unknown = sorted(set(fields) - {"spent", "turn", "history", "feature_query_asked", "last_query_scene_id"})

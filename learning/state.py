@@ -93,7 +93,8 @@ class LearningState:
             previous = dict(self._subsets)
             subset = read_only(answer)
             self._commit(progress=progress, scene=scene, subsets={c: subset for c in self.concepts})
-            return Change("features", features=tuple(int(i) for i in answer), previous_subsets=previous)
+            return Change("features", features=tuple(int(i) for i in answer), previous_subsets=previous,
+                          cost=self._progress.cost(action))
         if action.kind == "label":
             concept, obj, source, x = answer, int(action.object_index), "label", scene.X[action.object_index]
         elif isinstance(answer, DemoRow):
@@ -104,12 +105,15 @@ class LearningState:
         if source == "demo":
             scene = replace(scene, demonstrated=scene.demonstrated | scene.rows_equal_to(example.x))
         self._commit(progress=progress, scene=scene, examples=self._examples + (example,))
-        return Change("example", concept=concept, object=obj, source=source, example=example)
+        return Change("example", concept=concept, object=obj, source=source, example=example,
+                      cost=self._progress.cost(action))
 
     def undo(self, change: Change) -> None:
-        """Take back what an applied answer taught (its example, or its feature subsets); the turn stays spent."""
+        """Take back what an applied answer taught (its example, or its feature subsets) and give back the budget its
+        turn was charged; a taken-back feature answer re-opens the feature question. The turn itself stays over."""
+        refunded = self._progress.refunded(change.cost, reopen_feature_query=change.kind == "features")
         if change.kind == "features" and change.previous_subsets is not None:
-            self._commit(subsets=change.previous_subsets)
+            self._commit(progress=refunded, subsets=change.previous_subsets)
             return
         if change.kind != "example":
             raise AnswerError(f"nothing to take back: a '{change.kind}' answer taught nothing")
@@ -123,7 +127,7 @@ class LearningState:
             still_shown = frozenset().union(*(scene.rows_equal_to(e.x) for e in examples
                                               if e.source == "demo" and e.scene_id == scene.scene_id))
             scene = replace(scene, demonstrated=scene.demonstrated & still_shown)
-        self._commit(scene=scene, examples=examples)
+        self._commit(progress=refunded, scene=scene, examples=examples)
 
     def add_prior(self, X, concepts, features=None) -> None:
         """What is known before the episode: examples (rows of ``X`` and their concepts, as label answers),

@@ -1,5 +1,6 @@
 """The teaching loop with a fake world and a scripted teacher."""
 
+import io
 import json
 
 import numpy as np
@@ -329,7 +330,7 @@ def test_an_undo_before_there_is_none_to_show_still_marks_the_concept_absent(tmp
     records = read_transcript(tmp_path / "t.jsonl")
     assert records[1]["undid"] == [1] and records[1]["answer"]["kind"] == "absent"
     assert "snack" in manager.state.absent_in_scene and manager.state.examples == ()
-    assert manager.state.history == ("label", "demo") and manager.state.spent == 3 == 5 - records[1]["budget_left"]
+    assert manager.state.history == ("label", "demo") and manager.state.spent == 2 == 5 - records[1]["budget_left"]
 
 
 def test_undo_takes_back_a_feature_choice_and_a_pantry_example(tmp_path):
@@ -345,5 +346,29 @@ def test_undo_takes_back_a_feature_choice_and_a_pantry_example(tmp_path):
     assert any("Taken back: the fruit from the pantry (turn 1)" in h for h in teacher.heard)
     assert all(s is None for s in manager.state.feature_subsets.values())
     assert records[2]["model"]["features_in_use"] == 3
-    assert [e.concept for e in manager.state.examples] == ["snack"] and manager.state.feature_query_asked
-    assert [r["budget_left"] for r in records] == [6, 4, 3]  # the undone turns stay spent
+    assert [e.concept for e in manager.state.examples] == ["snack"] and not manager.state.feature_query_asked
+    assert [r["budget_left"] for r in records] == [6, 4, 7]  # the undone answers' budget (2 + 2) is given back
+
+
+@pytest.mark.parametrize("first, answer, cost", [
+    (LabelQuery(0), "a fruit", 1), (DemoQuery("fruit"), "1", 2), (DemoQuery("fruit"), "none", 2),
+    (FeatureQuery(), "f1, f2", 2)])
+def test_undo_gives_the_budget_back_for_every_query_kind(tmp_path, first, answer, cost):
+    """Issue 23 case 7: an undone answer used to keep its budget spent, and an undone feature answer closed the
+    feature question for good. Now the budget comes back and the feature question may be asked again."""
+    from dialog.terminal import TerminalTeacher
+    out = io.StringIO()
+    teacher = TerminalTeacher(io.StringIO(f"{answer}\nundo\na snack\nf3\n"), out, clock=VirtualClock())
+    env = PantryEnvironment(missing=("fruit",) if answer == "none" else ())
+    manager = manager_for(tmp_path / "t.jsonl", env, teacher,
+                          ScriptedStrategy([first, LabelQuery(1), FeatureQuery()]), turns=3, budget=8)
+    manager.run()
+    records = read_transcript(tmp_path / "t.jsonl")
+    assert records[1]["undid"] == [1]
+    assert records[1]["budget_left"] == 8 - 1  # only the second turn's label is spent
+    assert records[2]["action"] == {"kind": "feature"}  # open again after a taken-back feature answer
+    assert records[2]["budget_left"] == 8 - 1 - 2
+    question = "Robot: " + records[1]["question"]
+    assert out.getvalue().count(records[1]["question"]) == 2  # asked once, repeated once by "Taken back: ..."
+    assert out.getvalue().count(question) == 1
+    assert cost == records[0]["cost"]

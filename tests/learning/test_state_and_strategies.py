@@ -96,4 +96,5 @@ def test_undo_removes_the_last_example(rng):
     change = state.apply(LabelQuery(1), "b")
     state.undo(change)
     assert change.concept == "b" and [e.concept for e in state.examples] == ["a"]
-    assert np.allclose(state.probabilities(), before) and state.turn == 2  # the turn stays spent
+    assert np.allclose(state.probabilities(), before) and state.turn == 2  # the turn stays over
+    assert state.spent == 1  # the taken-back label's budget is given back

@@ -176,7 +176,7 @@ def test_apply_records_the_turn_in_the_right_order(rng):
     assert state.apply(NoQuery()).kind == "none" and state.quiet_run() == 1 and state.last_query_scene_id == 0
 
 
-def test_undo_takes_back_the_answer_but_not_the_turn(rng):
+def test_undo_takes_back_the_answer_and_its_budget_but_not_the_turn(rng):
     state = _state(rng)
     before = _snapshot(state)
     shown = state.apply(DemoQuery("c"), 6)
@@ -188,7 +188,7 @@ def test_undo_takes_back_the_answer_but_not_the_turn(rng):
     for key in ("examples", "predictions", "subsets", "scaler"):
         assert after[key] == before[key], key
     assert 6 not in state.demonstrated_in_scene and 3 in state.demonstrated_in_scene
-    assert state.turn == 4 and state.spent == 7 and state.feature_query_asked
+    assert state.turn == 4 and state.spent == 3 and not state.feature_query_asked  # 2 + 2 given back, FQ re-opened
     with pytest.raises(ValueError, match="already taken back"):
         state.undo(shown)
     fetched = state.apply(DemoQuery("a"), DemoRow(state.scene_X[1]))  # a row equal to object 1 marks it shown
