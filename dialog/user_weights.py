@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import sys
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -36,6 +37,18 @@ class UserWeights:
     def record(self) -> dict:
         """What a transcript header or a report stores: the file and the values."""
         return {"file": self.file, "values": dict(self.values)}
+
+    def never_asks(self) -> bool:
+        """True when no state can make a question score above staying quiet: every weight is 0 but perhaps
+        remaining_time's, which under eq. 7.1 is the same for every candidate of a turn (ties go to no query)."""
+        return all(value == 0 for name, value in self.values if name != "remaining_time")
+
+    def warn_if_never_asks(self) -> None:
+        """One line on stderr when :meth:`never_asks`: such a file runs, but the robot stays quiet every turn."""
+        if self.never_asks():
+            print(f"warning: {self.file}: every weight that can tell a question from staying quiet is 0, so this DT "
+                  "never asks (every turn ties with no query); fit the weights again (teachbot learn-weights) or edit "
+                  "the file", file=sys.stderr, flush=True)
 
     def describe(self) -> str:
         return f"{self.file} (" + ", ".join(f"{name} {value:g}" for name, value in self.values) + ")"
@@ -78,6 +91,7 @@ def read_named_weights(pairs) -> dict[str, UserWeights]:
         if name in found:
             raise SettingsError(f"--weights: the strategy name '{name}' is given twice; give each its own name")
         found[name] = read_user_weights(path)
+        found[name].warn_if_never_asks()
     return found
 
 
@@ -91,7 +105,9 @@ def weights_strategy(strategy: str, weights_file: Path | None) -> tuple[str, Use
     if strategy not in DT_STRATEGIES:
         raise SettingsError(f"--weights gives the weights of a decision-theoretic strategy, but --strategy {strategy} "
                             f"does not use weights; leave --strategy out or give one of {', '.join(DT_STRATEGIES)}")
-    return WEIGHTS_STRATEGY_NAME, read_user_weights(weights_file)
+    weights = read_user_weights(weights_file)
+    weights.warn_if_never_asks()
+    return WEIGHTS_STRATEGY_NAME, weights
 
 
 def weights_from_record(recorded) -> UserWeights:

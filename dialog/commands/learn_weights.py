@@ -17,6 +17,7 @@ from pathlib import Path
 
 from dialog.commands._arguments import positive_int, seed
 from dialog.output_paths import check_writable, writing
+from dialog.user_weights import UserWeights
 from learning.errors import OutputPathError, SettingsError
 
 # Trajectory defaults: sized so that 100 iterations fit in about 10 minutes on a 2-core machine (docs/irl.md).
@@ -91,6 +92,7 @@ def run(args: argparse.Namespace, output_stream=None) -> int:
         note = "  (unidentified: equal on every candidate)" if name in learned.result.unidentified_features else ""
         print(f"  {name:<30} {value:>12.4f}{note}", file=out)
     print(f"wrote {args.out}", file=out)
+    UserWeights(str(args.out), tuple(learned.weights.as_dict().items())).warn_if_never_asks()
     if args.json:
         print(json.dumps(learned.summary()), file=out, flush=True)
     return 0

@@ -94,3 +94,15 @@ def test_regress_on_ray_carries_the_weights_and_the_data_seed(tmp_path, capsys, 
     assert [[",".join(r.split(",")[:10]) for r in table] for table in rows][0] == \
         [",".join(r.split(",")[:10]) for r in rows[1]]
     assert [r.split(",")[1] for r in rows[0][1:]] == ["passive", "mine"]
+
+
+def test_weights_that_can_never_ask_are_warned_about_in_one_line(tmp_path, capsys):
+    """Issue 23 case 2: seven zero weights (what a fit that learned nothing writes) ran 30 silent turns unremarked."""
+    zeros = {name: 0.0 for name in DT_TASK_LIKE} | {"remaining_time": 3.0}  # RT alone ties every candidate
+    path = save_weights(tmp_path / "zeros.toml", DecisionWeights(tuple(zeros), list(zeros.values()), {}), comment="")
+    assert main(["demo", "--weights", str(path), "--turns", "3", "--transcript", str(tmp_path / "d.jsonl")]) == 0
+    warned = [line for line in capsys.readouterr().err.splitlines() if "never asks" in line]
+    assert len(warned) == 1 and warned[0].startswith(f"warning: {path.resolve()}:")
+    assert main(["regress", "--suite", "smoke", "--weights", f"zeros={path}", "--results", str(tmp_path / "r"),
+                 "--no-progress"]) == 0
+    assert sum("never asks" in line for line in capsys.readouterr().err.splitlines()) == 1
