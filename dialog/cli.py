@@ -15,6 +15,7 @@ import signal
 import sys
 
 import dialog.commands
+from dialog import software_version
 from dialog.commands._arguments import TeachbotParser
 from dialog.interrupts import CleanSignals, exit_code
 from dialog.threads import one_blas_thread
@@ -24,6 +25,7 @@ from learning.errors import TeachbotError
 def build_parser() -> argparse.ArgumentParser:
     parser = TeachbotParser(
         prog="teachbot", description="A robot in a PyBullet kitchen that learns task words by asking questions.")
+    parser.add_argument("--version", action="version", version=software_version())
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     for module_info in sorted(pkgutil.iter_modules(dialog.commands.__path__), key=lambda m: m.name):
         if module_info.name.startswith("_"):

@@ -99,6 +99,8 @@ def run(args: argparse.Namespace) -> int:
         print(f"  not checked (--weights strategies, no baseline): {', '.join(suite.weights)}")
     for failure in failures:
         print(f"  REGRESSION {failure}")
+    if args.check:
+        print(failures.verdict())
     if args.json:
         data = {} if suite.kind == "recipes" else {"data_seed": suite.data_seed}  # recipes render no data sets
         print(json.dumps({"suite": suite.name, "episodes": outcome.count, "seconds": round(outcome.seconds, 2),

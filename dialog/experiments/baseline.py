@@ -74,21 +74,39 @@ def refuse_baseline_from_another_run(suite: Suite, original: Suite) -> None:
                             "store the baseline without those options (or edit the suite file)")
 
 
-def check_against_baseline(suite: Suite, summaries: list[CheckpointSummary], path: Path | None = None) -> list[str]:
+class BaselineFailures(list):
+    """The readable failures of a baseline check (a list of str; empty: all inside) and ``checked``, how many
+    checkpoint bands were compared, for the pass line ("12 of 12 within bands")."""
+
+    checked: int = 0
+
+    def verdict(self) -> str:
+        within = max(self.checked - sum(" band [" in failure for failure in self), 0)
+        if not self:
+            return f"baseline check: passed ({within} of {self.checked} within bands)"
+        return f"baseline check: FAILED ({len(self)} problem{'s' if len(self) != 1 else ''}; {within} of " \
+               f"{self.checked} bands within)"
+
+
+def check_against_baseline(suite: Suite, summaries: list[CheckpointSummary],
+                           path: Path | None = None) -> BaselineFailures:
     """Readable differences for every checkpoint mean outside its stored band (empty: all inside)."""
+    failures = BaselineFailures()
     path = path or baseline_path(suite)
     if not path.exists():
-        return [f"no stored baseline for suite '{suite.name}' at {path}; run with --update-baseline first"]
+        failures.append(f"no stored baseline for suite '{suite.name}' at {path}; run with --update-baseline first")
+        return failures
     try:
         stored = json.loads(path.read_text(encoding="utf-8"))
         bands, data_seed = stored["bands"], stored.get("data_seed", 0)
     except (json.JSONDecodeError, KeyError, AttributeError, TypeError) as error:
-        return [f"baseline {path} is unreadable ({error}); rewrite it with --update-baseline"]
+        failures.append(f"baseline {path} is unreadable ({error}); rewrite it with --update-baseline")
+        return failures
     if data_seed != suite.data_seed:
-        return [f"baseline {path} was made on data seed {data_seed}, this run on data seed {suite.data_seed}: "
-                "not comparable"]
+        failures.append(f"baseline {path} was made on data seed {data_seed}, this run on data seed "
+                        f"{suite.data_seed}: not comparable")
+        return failures
     axis = suite.axis  # questions, turns or demonstrations
-    failures = []
     for s in summaries:
         stored = bands.get(s.condition, {}).get(s.strategy)
         if stored is None and (s.strategy in suite.weights or s.strategy.startswith(RL_PREFIX)):
@@ -101,6 +119,7 @@ def check_against_baseline(suite: Suite, summaries: list[CheckpointSummary], pat
             if entry is None or not np.isfinite(mean):
                 continue
             low, high = entry["band"]
+            failures.checked += 1
             if not low <= mean <= high:
                 side = "below" if mean < low else "above"
                 failures.append(f"{s.strategy}/{s.condition} after {checkpoint} {axis}: accuracy {mean:.3f} is "

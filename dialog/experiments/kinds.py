@@ -22,7 +22,7 @@ from pathlib import Path
 from typing import Any, ClassVar
 
 from dialog.experiments.analysis import CheckpointSummary, FindingResult, skipped_by_overrides
-from dialog.experiments.baseline import check_against_baseline
+from dialog.experiments.baseline import BaselineFailures, check_against_baseline
 from dialog.experiments.suite import Suite, SuiteError
 
 BUILTIN_KIND_MODULES = ("dialog.experiments.episode_kind", "dialog.experiments.features.kind",
@@ -69,7 +69,7 @@ class SuiteKind(ABC):
     def report(self, run: SuiteRun, folder: Path) -> list[Path]:
         """Write the report (first path), its tables and figures into ``folder``."""
 
-    def check(self, run: SuiteRun, baseline: Path | None = None) -> list[str]:
+    def check(self, run: SuiteRun, baseline: Path | None = None) -> BaselineFailures:
         """Readable differences from the stored baseline bands (empty: every mean is inside)."""
         return check_against_baseline(run.suite, run.summaries, baseline)
 

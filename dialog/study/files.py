@@ -12,21 +12,14 @@ from __future__ import annotations
 import json
 import os
 from dataclasses import dataclass
-from importlib import metadata
 from pathlib import Path
 
+from dialog import software_version
 from dialog.output_paths import writing
 from dialog.transcript import read_session
 from learning.errors import TranscriptError
 
 STATES = ("missing", "running", "questionnaire", "done", "aborted")
-
-
-def software_version() -> str:
-    try:
-        return f"teachbot {metadata.version('teachbot')}"
-    except metadata.PackageNotFoundError:
-        return "teachbot (not installed)"
 
 
 def study_header(study, participant: str, condition: str, order: int) -> dict:

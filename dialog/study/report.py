@@ -13,9 +13,10 @@ from pathlib import Path
 import numpy as np
 from matplotlib.figure import Figure
 
+from dialog import software_version
 from dialog.experiments.figures import COLOURS, LINE_STYLES
 from dialog.output_paths import check_writable, writing
-from dialog.study.files import software_version, write_atomically
+from dialog.study.files import write_atomically
 from dialog.study.paired import paired_test
 from dialog.study.tables import ANSWER_COLUMNS, TURN_COLUMNS, collect, write_csv
 from learning.significance import mean_and_standard_error

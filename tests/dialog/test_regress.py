@@ -78,10 +78,12 @@ def test_findings_and_baseline_bands(tmp_path):
     (finding,) = evaluate_findings(summaries, suite)
     assert finding.holds and finding.comparisons[0].p < 0.01
     path = write_baseline(suite, summaries, tmp_path / "base.json")
-    assert check_against_baseline(suite, summaries, path) == []
+    passed = check_against_baseline(suite, summaries, path)
+    assert passed == [] and passed.verdict() == "baseline check: passed (6 of 6 within bands)"
     worse = summarise([fake_result("passive", [0.5, 0.5, 0.5, 0.5], [1, 2, 3, 3])] + results[5:], suite)
     failures = check_against_baseline(suite, worse, path)
     assert failures and "passive/static after 2 questions: accuracy 0.500 is below its band" in failures[0]
+    assert failures.verdict() == f"baseline check: FAILED ({len(failures)} problems; {6 - len(failures)} of 6 bands within)"
     assert "no stored baseline" in check_against_baseline(suite, summaries, tmp_path / "missing.json")[0]
 
 
@@ -98,6 +100,17 @@ def test_a_tiny_suite_runs_end_to_end(tmp_path, capsys):
     assert len(rows) == 5 and rows[0].startswith("condition,strategy")
     first = np.loadtxt(tmp_path / "out" / "episodes" / "static" / "passive-d0-s0.csv", delimiter=",", skiprows=1)
     assert first.shape == (4, 7) and first[-1, 6] <= 3
+
+
+def test_check_prints_its_verdict_without_json(tmp_path, capsys, monkeypatch):
+    """Issue 23 case 9: --check used to say nothing when it passed unless --json was given."""
+    monkeypatch.setattr("dialog.experiments.baseline.BASELINE_DIR", tmp_path / "baselines")
+    suite = str(write_suite(tmp_path))
+    common = ["regress", "--suite", suite, "--results", str(tmp_path / "out"), "--workers", "1", "--no-progress"]
+    assert main(common + ["--update-baseline"]) == 0
+    capsys.readouterr()
+    assert main(common + ["--check"]) == 0
+    assert capsys.readouterr().out.splitlines()[-1] == "baseline check: passed (6 of 6 within bands)"
 
 
 def test_the_same_suite_runs_on_a_local_ray_instance(tmp_path, capsys):

@@ -27,3 +27,9 @@ def test_importing_the_packages_prints_nothing():
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120, check=False)
     assert result.returncode == 0, result.stderr
     assert result.stdout == "" and result.stderr == ""
+
+
+def test_version_names_the_installed_package():
+    from importlib import metadata
+    result = _run("--version")
+    assert result.returncode == 0 and result.stdout == f"teachbot {metadata.version('teachbot')}\n"
