@@ -8,6 +8,7 @@ import sys
 from pathlib import Path
 
 from dialog.commands._arguments import add_kitchen_option, add_task_option, budget, positive_int, seed
+from dialog.commands._summary import questions_in_words
 from dialog.expert import ExpertSettings
 from learning.actions import DEFAULT_COSTS
 
@@ -87,9 +88,11 @@ def run(args: argparse.Namespace, input_stream=None, output_stream=None) -> int:
     finally:
         environment.close()
     result = outcome.result
-    print(f"{'Stopped' if result.quit else 'Done'} after {len(outcome.episode.turns)} turns: accuracy "
-          f"{result.accuracy:.1%}, budget spent {result.budget_spent:g} of {settings.budget:g}, queries "
-          f"{result.queries}. Demonstration: {outcome.demonstration}; transcript: {outcome.transcript}",
+    turns = len(outcome.episode.turns)
+    print(f"{'Stopped' if result.quit else 'Done'} after {turns} turn{'' if turns == 1 else 's'}: accuracy "
+          f"{result.accuracy:.1%}, budget spent {result.budget_spent:g} of {settings.budget:g}; "
+          f"{questions_in_words(result.queries)}. Demonstration: {outcome.demonstration}; "
+          f"transcript: {outcome.transcript}",
           file=out, flush=True)
     if args.json:
         print(json.dumps({"seed": settings.seed, "expert": chooser.name, "turns": len(outcome.episode.turns),

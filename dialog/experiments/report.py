@@ -68,6 +68,23 @@ def write_markdown(lines: list[str], out: Path) -> Path:
     return path
 
 
+def numbers_in_words(numbers) -> str:
+    """(0, 1, 2, 3, 4) -> "0-4"; (0, 2, 7) -> "0, 2, 7" (as a reader writes seeds, never a Python list)."""
+    values = [int(n) for n in numbers]
+    if len(values) > 2 and values == list(range(values[0], values[0] + len(values))):
+        return f"{values[0]}-{values[-1]}"
+    return ", ".join(str(v) for v in values)
+
+
+def teacher_in_words(teacher: dict) -> str:
+    """{} -> "scripted"; {"kind": "scripted", "mislabel_rate": 0.1} -> "scripted (mislabel rate 0.1)"."""
+    options = {k: v for k, v in dict(teacher or {}).items() if k != "kind"}
+    kind = (teacher or {}).get("kind", "scripted")
+    if not options:
+        return str(kind)
+    return f"{kind} (" + ", ".join(f"{k.replace('_', ' ')} {v}" for k, v in sorted(options.items())) + ")"
+
+
 def markdown_report(suite: Suite, results: list[dict], summaries: list[CheckpointSummary],
                     findings: list[FindingResult], seconds: float, out: Path, figures: list[Path]) -> Path:
     """``report.md``: per condition the figures, accuracy at the checkpoints inside its turns, pairwise
@@ -75,7 +92,7 @@ def markdown_report(suite: Suite, results: list[dict], summaries: list[Checkpoin
     axis_name = {"questions": "questions asked", "seconds": "seconds"}.get(suite.axis, "turns")
     lines = [f"# Regression report: {suite.name}", "", suite.description, "",
              f"- task `{suite.task}`, kitchen `{suite.kitchen}`, {suite.datasets} training data sets, "
-             f"seeds {list(suite.seeds)}, teacher {suite.teacher or {'kind': 'scripted'}}",
+             f"seeds {numbers_in_words(suite.seeds)}, teacher {teacher_in_words(suite.teacher)}",
              f"- data sets rendered from data seed {suite.data_seed}"
              + (" (the data of the stored baselines)" if suite.data_seed == 0 else " (fresh data: a replication)"),
              *[f"- strategy `{name}`: DT with the weights in {weights.describe()}"

@@ -26,6 +26,7 @@ def test_world_check_ends_with_one_json_line(capsys):
                  "--json"]) == 0
     captured = capsys.readouterr()
     assert "scene 2: 6 objects in this scene, 12 in total so far (of at least 12)" in captured.err  # totals say so
+    assert captured.out.startswith("12 objects in 2 scenes (kitchen-1): ")
     result = json.loads(captured.out.strip().splitlines()[-1])
     assert set(result) >= {"objects", "size_err_mm", "loc_err_mm", "features", "ms_per_scene"}
     assert result["objects"] >= 12 and set(result["size_err_mm"]) == {"median", "p95"}
@@ -36,9 +37,12 @@ def test_world_data_builds_then_reuses_the_cache(tmp_path, capsys):
     arguments = ["world", "data", "--task", "prepare-lunch", "--no-robot", "--cache", str(tmp_path), "--json",
                  "--pool-size", "80", "--test-size", "40"]
     assert main(arguments) == 0
-    first = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
+    first_lines = capsys.readouterr().out.strip().splitlines()
+    first = json.loads(first_lines[-1])
     assert first["train"] == [80] * 5 and first["test"] == 40 and first["features"] == 56
     assert main(arguments) == 0
     captured = capsys.readouterr()
     assert json.loads(captured.out.strip().splitlines()[-1])["file"] == first["file"]
     assert "pool" not in captured.err  # nothing rendered the second time
+    assert "built in" in first_lines[0] and "cache" not in first_lines[0]
+    assert ": 5 training pools of 80" in captured.out and "; loaded from the cache in " in captured.out

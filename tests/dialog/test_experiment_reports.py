@@ -218,3 +218,11 @@ def test_a_recipe_finding_without_trials_is_skipped_with_the_arms_it_misses():
     assert len(outcomes) == len(suite.findings) and not any(o.holds for o in outcomes)
     first = suite.findings[0]
     assert outcomes[0].skipped.startswith(f"no trials of {first.better} at m = {first.at}")
+
+
+def test_report_headers_say_seeds_and_teachers_in_words():
+    from dialog.experiments.report import numbers_in_words, teacher_in_words
+    assert numbers_in_words((0, 1, 2, 3, 4)) == "0-4" and numbers_in_words((0, 2, 7)) == "0, 2, 7"
+    assert numbers_in_words((3,)) == "3" and numbers_in_words((0, 1)) == "0, 1"
+    assert teacher_in_words({}) == "scripted" and teacher_in_words({"kind": "oracle"}) == "oracle"
+    assert teacher_in_words({"kind": "scripted", "mislabel_rate": 0.1}) == "scripted (mislabel rate 0.1)"

@@ -159,3 +159,11 @@ def test_shipped_demonstrations_are_the_suite_episodes_of_the_expert_strategy(tm
     questions = {kind: chosen.count(kind) for kind in ("label", "demo", "feature")}
     assert all(episode["series"][kind][-1] == count for kind, count in questions.items())
     assert episode["accuracy"] == pytest.approx(outcome.result.accuracy)
+
+
+def test_the_expert_summary_is_words_not_a_python_dict(tmp_path, capsys):
+    from dialog.cli import main
+    assert main(["expert", "--expert", "scripted", "--turns", "1", "--out", str(tmp_path)]) == 0
+    last = capsys.readouterr().out.strip().splitlines()[-1]
+    assert last.startswith("Done after 1 turn: ") and "{" not in last
+    assert ", 0 demonstrations, " in last or ", 1 demonstration, " in last

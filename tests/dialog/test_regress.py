@@ -83,7 +83,8 @@ def test_findings_and_baseline_bands(tmp_path):
     worse = summarise([fake_result("passive", [0.5, 0.5, 0.5, 0.5], [1, 2, 3, 3])] + results[5:], suite)
     failures = check_against_baseline(suite, worse, path)
     assert failures and "passive/static after 2 questions: accuracy 0.500 is below its band" in failures[0]
-    assert failures.verdict() == f"baseline check: FAILED ({len(failures)} problems; {6 - len(failures)} of 6 bands within)"
+    within = 6 - len(failures)
+    assert failures.verdict() == f"baseline check: FAILED ({len(failures)} problems; {within} of 6 bands within)"
     assert "no stored baseline" in check_against_baseline(suite, summaries, tmp_path / "missing.json")[0]
 
 
