@@ -15,7 +15,7 @@ from dialog.commands.teach import DEFAULT_STRATEGY
 from dialog.environment import SimulatedKitchen
 from dialog.experiments.runner import file_label
 from dialog.manager import DialogManager, episode_generators
-from dialog.settings import EpisodeSettings
+from dialog.settings import DEFAULTS, EpisodeSettings
 from dialog.teachers import OracleTeacher
 from dialog.transcript import FORMAT, TranscriptWriter
 from dialog.transcript_lock import TranscriptLock
@@ -35,7 +35,8 @@ def register(commands) -> None:
     add_episode_options(parser, STRATEGY_NAMES, DEFAULT_STRATEGY)
     add_time_options(parser)
     parser.add_argument("--transcript", type=Path, default=None,
-                        help="transcript path (default runs/demo-<strategy>-seed<seed>.jsonl)")
+                        help="transcript path (default runs/demo-<strategy>-seed<seed>.jsonl; a non-default "
+                             "task, kitchen or --embodied-costs adds itself to the name)")
     add_weights_option(parser)
     add_viewer_option(parser)
     parser.add_argument("--json", action="store_true", help="end with one JSON line summarising the episode")
@@ -61,6 +62,17 @@ def refuse_foreign_transcript(path: Path, lock: TranscriptLock) -> None:
                               "(choose another --transcript)")
 
 
+def default_transcript(args: argparse.Namespace, seconds: float | None) -> Path:
+    """runs/demo-<strategy>[-<task>][-<kitchen>][-embodied-<N>s]-seed<seed>.jsonl: the parts that differ from the
+    defaults name the file, so an embodied demo does not overwrite the plain demo's transcript."""
+    parts = [file_label(args.strategy)]
+    parts += [value for value, default in ((args.task, DEFAULTS.task), (args.kitchen, DEFAULTS.kitchen))
+              if value != default]
+    if seconds is not None:
+        parts.append(f"embodied-{seconds:g}s")
+    return Path("runs") / f"demo-{'-'.join(parts)}-seed{args.seed}.jsonl"
+
+
 def run(args: argparse.Namespace) -> int:
     turns, seconds = resolve_time(args)
     args.strategy, weights = weights_strategy(args.strategy, args.weights)  # --weights: DT shown as "dt"
@@ -78,7 +90,7 @@ def run(args: argparse.Namespace) -> int:
         costs = load_embodied_costs()
         clock, delays, joint_speed = VirtualClock(), costs.answer, costs.joint_speed
     rngs = episode_generators(args.seed)
-    transcript_path = args.transcript or Path("runs") / f"demo-{file_label(args.strategy)}-seed{args.seed}.jsonl"
+    transcript_path = args.transcript or default_transcript(args, seconds)
     lock = TranscriptLock(transcript_path)  # checked and held before the kitchen is built: one writer per file
     try:
         refuse_foreign_transcript(transcript_path, lock)

@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
+from matplotlib.ticker import MaxNLocator
 
 from dialog.experiments.analysis import group_results
 from dialog.experiments.suite import Condition, Suite
@@ -145,6 +146,7 @@ def timing_figure(results: list[dict], suite: Suite, condition: Condition) -> Fi
     axis.set_ylim(-0.7, len(suite.strategies) - 0.3)
     axis.set_xlim(0, condition.turns + 1)
     axis.set_xlabel("turn (grey lines: the scene changes)")
+    axis.xaxis.set_major_locator(MaxNLocator(integer=True))  # turns are whole numbers
     episode = f"the episode of data set {shown[0]}, seed {shown[1]}" if shown else "no episode"
     axis.set_title(f"{suite.name}: {condition.name}: turns on which each strategy asked, in {episode} "
                    "(the same scenes for every strategy)", fontsize=9)

@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 from matplotlib.figure import Figure
+from matplotlib.ticker import MaxNLocator
 
 from dialog import software_version
 from dialog.experiments.figures import COLOURS, LINE_STYLES
@@ -68,6 +69,7 @@ def curve_figure(study, sessions) -> Figure:
         axis.plot(turns, mean, color=colour, linestyle=LINE_STYLES[index % len(LINE_STYLES)], marker="o",
                   markersize=3, label=f"{condition.name} (n={len(curves)})")
     axis.set_xlabel("turn")
+    axis.xaxis.set_major_locator(MaxNLocator(integer=True))  # turns are whole numbers
     axis.set_ylabel("held-out accuracy")
     axis.set_title(f"Study '{study.name}': learning curves (mean, band = range over participants)", fontsize=9)
     axis.set_ylim(0, 1)

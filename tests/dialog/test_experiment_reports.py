@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 
 import numpy as np
@@ -185,6 +186,9 @@ def test_ten_strategies_get_distinct_styles_and_every_panel_a_legend(tmp_path):
     assert "in the episode of data set 0, seed 0" in axis.get_title()
     colours = {tuple(np.round(c.get_facecolor()[0], 3)) for c in axis.collections}
     assert len(colours) == 10
+    (twenty,) = timing_figure(results, suite, dataclasses.replace(long, turns=20)).axes  # smoke's 20 turns
+    ticks = twenty.xaxis.get_major_locator()()
+    assert len(ticks) > 3 and all(float(t).is_integer() for t in ticks)  # there is no turn 2.5
 
 
 def test_rendering_the_data_sets_reports_progress_with_the_time(tmp_path, monkeypatch, capsys):

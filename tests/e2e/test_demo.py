@@ -58,3 +58,15 @@ def test_the_summary_counts_questions_in_words_and_the_json_keeps_its_counts(tmp
     assert set(summary["queries"]) == {"label", "demo", "feature", "none"}
     assert f"questions: {questions_in_words(summary['queries'])};" in lines[-2]
     assert "{'" not in lines[-2]
+
+
+def test_default_transcript_names_say_what_differs_from_the_defaults():
+    """Issue 23 case 11: the embodied demo wrote runs/demo-dt-task-seed0.jsonl over the plain demo's transcript."""
+    from dialog.cli import build_parser
+    from dialog.commands.demo import default_transcript
+    parse = build_parser().parse_args
+    assert str(default_transcript(parse(["demo"]), None)) == "runs/demo-dt-task-seed0.jsonl"  # unchanged
+    assert str(default_transcript(parse(["demo", "--embodied-costs"]), 600.0)) == \
+        "runs/demo-dt-task-embodied-600s-seed0.jsonl"
+    assert str(default_transcript(parse(["demo", "--task", "prepare-lunch", "--seed", "3"]), None)) == \
+        "runs/demo-dt-task-prepare-lunch-seed3.jsonl"
