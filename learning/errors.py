@@ -9,6 +9,8 @@ Anything else is a bug and keeps its traceback.
 
 from __future__ import annotations
 
+import difflib
+
 
 class TeachbotError(ValueError):
     """Bad input of any kind: a file, a path, a value, a recorded session."""
@@ -42,3 +44,10 @@ class SetupError(TeachbotError, RuntimeError):
 
     Also a ``RuntimeError``, which these were before.
     """
+
+
+def did_you_mean(text: str, names) -> str:
+    """" (did you mean 'dt-task'?)" when ``text`` is close to one of ``names`` (the closest), else "": the hint
+    an unknown name's message carries."""
+    close = difflib.get_close_matches(str(text).lower(), [str(n) for n in names], n=1, cutoff=0.6)
+    return f" (did you mean '{close[0]}'?)" if close else ""

@@ -9,6 +9,7 @@ from pathlib import Path
 
 from bullet_world.datafiles import available
 from dialog.settings import DEFAULTS, EpisodeSettings
+from learning.errors import did_you_mean
 from learning.strategies.rl_questioner import PREFIX as RL_PREFIX
 
 
@@ -110,7 +111,8 @@ def task_name(text: str) -> str:
     """A task data file's name, or a path to a task .toml file."""
     if text.endswith(".toml") or text in task_names():
         return text
-    raise argparse.ArgumentTypeError(f"no task '{text}'; accepted: {', '.join(task_names())} (or a task .toml file)")
+    raise argparse.ArgumentTypeError(f"no task '{text}'{did_you_mean(text, task_names())}; accepted: "
+                                     f"{', '.join(task_names())} (or a task .toml file)")
 
 
 def kitchen_name(text: str) -> str:
@@ -119,7 +121,8 @@ def kitchen_name(text: str) -> str:
     if name.endswith(".toml") or name in kitchen_names():
         return name
     numbers = ", ".join(name.removeprefix("kitchen-") for name in kitchen_names())
-    raise argparse.ArgumentTypeError(f"no kitchen '{text}'; accepted: {', '.join(kitchen_names())} (or just the "
+    raise argparse.ArgumentTypeError(f"no kitchen '{text}'{did_you_mean(name, kitchen_names())}; accepted: "
+                                     f"{', '.join(kitchen_names())} (or just the "
                                      f"number: {numbers}; or a kitchen .toml file)")
 
 
@@ -165,7 +168,8 @@ def strategy_choice(strategies):
             return RL_PREFIX + str(Path(text[len(RL_PREFIX):]).resolve())
         if text in strategies:
             return text
-        raise argparse.ArgumentTypeError(f"'{text}' is not one of the accepted names: {', '.join(strategies)}, or "
+        raise argparse.ArgumentTypeError(f"'{text}'{did_you_mean(text, strategies)} is not one of the accepted names: "
+                                         f"{', '.join(strategies)}, or "
                                          "rl:FILE (a trained questioner policy .toml)")
     return parse
 

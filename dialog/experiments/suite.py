@@ -12,7 +12,7 @@ from pathlib import Path
 
 from learning.actions import DEFAULT_COSTS
 from learning.datafiles import check_keys, integer, number, numbers, read_toml, section, tables, text, texts
-from learning.errors import DataFileError
+from learning.errors import DataFileError, did_you_mean
 from learning.significance import ALTERNATIVES
 
 SUITE_DIR = Path(__file__).resolve().parents[1] / "suites"
@@ -147,7 +147,8 @@ def load_suite(name_or_path: str | Path, known_strategies=None) -> Suite:
     if path.suffix != ".toml":
         path = SUITE_DIR / f"{name_or_path}.toml"
         if not path.exists():
-            raise SuiteError(f"unknown suite '{name_or_path}'; available: {', '.join(suite_names())}")
+            raise SuiteError(f"unknown suite '{name_or_path}'{did_you_mean(str(name_or_path), suite_names())}; "
+                             f"available: {', '.join(suite_names())}")
     table = _read(path)
     where = str(path)
     try:

@@ -22,7 +22,7 @@ import numpy as np
 
 from learning.decision.features import FEATURE_NAMES
 from learning.decision.weights_file import load_weights
-from learning.errors import SettingsError
+from learning.errors import SettingsError, did_you_mean
 
 WEIGHTS_DIRECTORY = Path(__file__).resolve().parent / "presets"
 PRESETS = ("dt", "dt-iros", "dt-task", "dt-task-env")
@@ -55,7 +55,8 @@ def load_weight_file(path: str | Path) -> np.ndarray:
 def preset_weights(name: str) -> np.ndarray:
     """The weights of a named preset (``PRESETS``), from learning/decision/presets/<name>.toml."""
     if name not in PRESETS:
-        raise SettingsError(f"unknown weight preset '{name}'; choose one of: {', '.join(PRESETS)}")
+        raise SettingsError(f"unknown weight preset '{name}'{did_you_mean(name, PRESETS)}; choose one of: "
+                            f"{', '.join(PRESETS)}")
     return load_weight_file(WEIGHTS_DIRECTORY / f"{name}.toml")
 
 

@@ -23,7 +23,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from functools import partial
 
-from learning.errors import SettingsError
+from learning.errors import SettingsError, did_you_mean
 from learning.strategies.active import ActiveStrategy
 from learning.strategies.all_cd import AllClassDistributionStrategy
 from learning.strategies.base import Strategy
@@ -61,8 +61,8 @@ def make_strategy(name: str, **options) -> Strategy:
         return RLQuestionerStrategy(str(name)[len(RL_PREFIX):], name=str(name), **options)
     key = str(name).strip().lower()
     if key not in STRATEGIES:
-        raise SettingsError(f"unknown strategy '{name}'; choose one of: {', '.join(STRATEGY_NAMES)}, "
-                            f"or {RL_PREFIX}FILE (a trained questioner policy .toml)")
+        raise SettingsError(f"unknown strategy '{name}'{did_you_mean(key, STRATEGY_NAMES)}; choose one of: "
+                            f"{', '.join(STRATEGY_NAMES)}, or {RL_PREFIX}FILE (a trained questioner policy .toml)")
     if key == "dt" and "weights" in options:
         return DecisionTheoreticStrategy(name="dt", **options)
     try:

@@ -82,3 +82,24 @@ def test_a_missing_resume_transcript_is_one_line(tmp_path, capsys):
 def test_too_many_objects_for_the_kitchen_is_a_scene_error():
     with pytest.raises(SceneError, match="cannot place 200 objects"):
         place([Footprint("rect", 0.1, 0.05)] * 200, load_kitchen("kitchen-1"), np.random.default_rng(0))
+
+
+@pytest.mark.parametrize("arguments, hint", [
+    (["demo", "--strategy", "dt-tsk"], "(did you mean 'dt-task'?)"),
+    (["demo", "--task", "pack-lunchbx"], "(did you mean 'pack-lunchbox'?)"),
+    (["demo", "--kitchen", "kitchn-2"], "(did you mean 'kitchen-2'?)"),
+    (["regress", "--suite", "smok"], "(did you mean 'smoke'?)"),
+])
+def test_an_unknown_name_close_to_a_known_one_says_which(arguments, hint, capsys):
+    try:
+        code = main(arguments)
+    except SystemExit as stop:  # argparse's own refusal of an option value
+        code = stop.code
+    assert code == 2
+    error = capsys.readouterr().err.strip().splitlines()[-1]
+    assert error.startswith("teachbot") and hint in error
+
+
+def test_a_name_close_to_nothing_gets_no_hint():
+    from learning.errors import did_you_mean
+    assert did_you_mean("xyzzy", ["smoke", "ch7"]) == ""
