@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import shlex
 from pathlib import Path
 
 from dialog.user_weights import check_weights_unchanged, weights_from_header
@@ -68,3 +69,21 @@ def check_resume_options(args: argparse.Namespace, settings, path: Path) -> None
                               "differ; leave them out, or start a new session without --resume")
     if settings.weights is not None:
         check_weights_unchanged(weights_from_header(settings.weights, path), path)
+
+
+# Options of a run that its files do not record, so a "continue with" line must repeat them: (option, attribute)
+UNRECORDED_TEACH_OPTIONS = (("--pictures", "pictures"), ("--no-pictures", "no_pictures"), ("--viewer", "viewer"),
+                            ("--viewer-export", "viewer_export"), ("--viewer-hold", "viewer_hold"))
+
+
+def continue_command(words: list, args: argparse.Namespace | None = None, options=UNRECORDED_TEACH_OPTIONS) -> str:
+    """The command that goes on where a run stopped: ``words`` (the command and what names the run) plus every
+    option of ``options`` that ``args`` gave, shell-quoted so that it can be pasted as printed."""
+    command = [str(word) for word in words]
+    for option, attribute in options if args is not None else ():
+        value = getattr(args, attribute, None)
+        if value is True:
+            command.append(option)
+        elif value not in (None, False):
+            command += [option, f"{value:g}" if isinstance(value, float) else str(value)]
+    return shlex.join(command)

@@ -19,8 +19,6 @@ def register(subparsers) -> None:
                     "the participant, to dry-run a study.")
     _study_arguments(run)
     run.add_argument("--participant", required=True, metavar="ID", help="the participant's id (never a name)")
-    run.add_argument("--simulated", action="store_true",
-                     help="a scripted teacher (the study's noise and delay models) plays the participant")
     run.add_argument("--condition", default=None, metavar="NAME", help="run only this condition")
     run.add_argument("--again", action="store_true",
                      help="with --condition: run a condition already done again (the old records are kept, renamed)")
@@ -43,13 +41,25 @@ def register(subparsers) -> None:
     _study_arguments(report)
     report.add_argument("--out", type=Path, default=None, metavar="DIR",
                         help="where the report goes (default: <study folder>/report)")
+    report.add_argument("--allow-mixed", action="store_true",
+                        help="report a folder that holds both simulated and real sessions (rows say which)")
     report.set_defaults(handler=_report)
 
 
 def _study_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("study", type=Path, metavar="STUDY.toml", help="the study file")
     parser.add_argument("--folder", type=Path, default=None, metavar="DIR",
-                        help="the study's records folder (default: the study file's 'folder')")
+                        help="the study's records folder (default: the study file's 'folder', or "
+                             f"'<folder>{SIMULATED_SUFFIX}' with --simulated)")
+    parser.add_argument("--simulated", action="store_true",
+                        help="a dry run: a scripted teacher (the study's noise and delay models) plays the "
+                             f"participant, and the records go to '<folder>{SIMULATED_SUFFIX}' unless --folder says")
+
+
+SIMULATED_SUFFIX = "-simulated"  # dry runs keep out of the folder where real participants' records go
+# run's options that its records do not hold, repeated by its "continue with" line (--again would supersede again)
+RUN_OPTIONS = (("--folder", "folder"), ("--simulated", "simulated"), ("--condition", "condition"),
+               ("--no-viewer", "no_viewer"))
 
 
 def _load(args):
@@ -58,14 +68,20 @@ def _load(args):
     study = load_study(args.study)
     if args.folder is not None:
         study = dataclasses.replace(study, folder=args.folder)
-    return study
+    elif args.simulated:
+        study = dataclasses.replace(study, folder=study.folder.with_name(study.folder.name + SIMULATED_SUFFIX))
+    return dataclasses.replace(study, simulated=args.simulated)
 
 
 def _run(args) -> int:
+    from dialog.commands._resume import continue_command
     from dialog.study.run import ParticipantRun
 
     study = _load(args)
-    runner = ParticipantRun(study, args.participant, args.simulated, viewer=False if args.no_viewer else None)
+    again = continue_command(["teachbot", "study", "run", args.study, "--participant", args.participant], args,
+                             RUN_OPTIONS)
+    runner = ParticipantRun(study, args.participant, args.simulated, viewer=False if args.no_viewer else None,
+                            continue_command=again)
     if args.abort is not None:
         return runner.abort(args.abort)
     return runner.run(args.condition, args.again)
@@ -82,7 +98,7 @@ def _report(args) -> int:
     from dialog.study.report import write_report
 
     study = _load(args)
-    written = write_report(study, args.out or study.folder / "report")
+    written = write_report(study, args.out or study.folder / "report", allow_mixed=args.allow_mixed)
     for path in written:
         print(path)
     return 0

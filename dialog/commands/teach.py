@@ -8,7 +8,7 @@ import sys
 from pathlib import Path
 
 from dialog.commands._arguments import add_episode_options, add_time_options, budget, positive_seconds, resolve_time
-from dialog.commands._resume import check_resume_options
+from dialog.commands._resume import check_resume_options, continue_command
 from dialog.commands._summary import questions_in_words, session_time
 from dialog.commands._viewer import add_viewer_option, hold_viewer, start_viewer, stop_viewer
 from dialog.environment import SimulatedKitchen
@@ -179,22 +179,22 @@ def _teach(args, settings: SessionSettings, path: Path, lock: TranscriptLock, in
         manager.say(intro)
         if person and len(records) < settings.turns and not manager.out_of_time():
             manager.say("Type 'help' at any question for what you can answer; 'quit' saves and stops.")
+        again = continue_command(["teachbot", "teach", "--resume", path], args)
         try:
             result = manager.run(replay=records)
         except KeyboardInterrupt:
-            manager.say(f"\nInterrupted. The session is saved; continue it with: teachbot teach --resume {path}")
+            manager.say(f"\nInterrupted. The session is saved; continue it with: {again}")
             return 130
         except OutputPathError as error:
             raise OutputPathError(f"{error}. The completed turns are saved; once that is fixed, continue with: "
-                                  f"teachbot teach --resume {path}") from None
+                                  f"{again}") from None
         finally:
             manager.transcript.close()
         if manager.replay_mismatches:
             manager.say(f"(note: on {manager.replay_mismatches} replayed turn(s) the strategy would now ask something "
                         "else; the recorded questions were kept)")
         if result.quit:
-            manager.say(f"Session saved after {result.completed} of {result.turns} turns. Continue it with: "
-                        f"teachbot teach --resume {path}")
+            manager.say(f"Session saved after {result.completed} of {result.turns} turns. Continue it with: {again}")
         manager.say(f"Accuracy on {settings.task} held-out scenes: {result.accuracy:.1%} (chance "
                     f"{1 / len(environment.concepts):.0%}); budget spent {result.budget_spent:g} of "
                     f"{settings.budget:g}; questions: {questions_in_words(result.queries)}; "

@@ -25,7 +25,7 @@ STATES = ("missing", "running", "questionnaire", "done", "aborted")
 def study_header(study, participant: str, condition: str, order: int) -> dict:
     """What every record of a participant's session names: who, which condition, which position, which software."""
     return {"study": study.name, "participant": participant, "condition": condition, "order": order,
-            "software": software_version()}
+            "software": software_version(), "simulated": study.simulated}
 
 
 @dataclass(frozen=True)

@@ -20,6 +20,7 @@ from dialog.output_paths import check_writable, writing
 from dialog.study.files import write_atomically
 from dialog.study.paired import paired_test
 from dialog.study.tables import ANSWER_COLUMNS, TURN_COLUMNS, collect, write_csv
+from learning.errors import TranscriptError
 from learning.significance import mean_and_standard_error
 
 KINDS = ("label", "demo", "feature", "none")
@@ -34,8 +35,14 @@ def _sessions(tables) -> dict:
     return sessions
 
 
-def _fmt(value, digits: int = 3) -> str:
-    return "–" if value is None or (isinstance(value, float) and np.isnan(value)) else f"{value:.{digits}g}"
+def _fmt(value, spec: str = ".3f") -> str:
+    """One number in one column's format (fixed decimals, so a column lines up: 0.160 beside 0.098); "–" for none."""
+    return "–" if value is None or (isinstance(value, float) and np.isnan(value)) else format(value, spec)
+
+
+def _p(value) -> str:
+    """A p value: three decimals, below 0.001 said as such."""
+    return "–" if value is None or np.isnan(value) else ("< 0.001" if value < 0.001 else f"{value:.3f}")
 
 
 def _table(header, rows) -> list[str]:
@@ -48,8 +55,8 @@ def _tests(names, values: dict, what: str) -> list[str]:
     rows = []
     for a, b in combinations(names, 2):
         test = paired_test(a, values.get(a, {}), b, values.get(b, {}))
-        rows.append([what, f"{a} vs {b}", test.n, _fmt(test.median_difference), _fmt(test.statistic),
-                     _fmt(test.p), f"{test.effect:+.2f}"])
+        rows.append([what, f"{a} vs {b}", test.n, _fmt(test.median_difference, "+.3f"), _fmt(test.statistic, ".1f"),
+                     _p(test.p), _fmt(test.effect, "+.2f")])
     return rows
 
 
@@ -104,11 +111,17 @@ def final_figure(study, final: dict) -> Figure:
     return figure
 
 
-def write_report(study, out: Path) -> list[Path]:
-    """Write turns.csv, questionnaire.csv, report.md and the two plots into ``out``; returns their paths."""
+def write_report(study, out: Path, allow_mixed: bool = False) -> list[Path]:
+    """Write turns.csv, questionnaire.csv, report.md and the two plots into ``out``; returns their paths.
+    Simulated (dry-run) and real sessions in one folder are refused unless ``allow_mixed``."""
     out = Path(out)
     check_writable(out, "study report", folder=True)
     tables = collect(study)
+    simulated, real = tables.simulated_sessions()
+    if simulated and real and not allow_mixed:
+        raise TranscriptError(f"{study.folder} holds {simulated} simulated (dry-run) and {real} real sessions; a "
+                              "report over both would mix a scripted teacher's answers with participants'. Move the "
+                              "dry run away, or report both with --allow-mixed (every row says which it is)")
     names = [c.name for c in study.conditions]
     sessions = _sessions(tables)
     done = {(c.participant, c.condition) for c in tables.cells if c.state.state == "done"}
@@ -134,7 +147,14 @@ def report_lines(study, tables, sessions, final, figures) -> list[str]:
              f"{len(study.participants)} participants planned, {len(finished)} with at least one finished session; "
              f"{sum(c.state.state == 'done' for c in tables.cells)} of {len(tables.cells)} sessions finished. "
              f"Report by {software_version()}. Tables: `turns.csv` (one row per recorded turn), "
-             "`questionnaire.csv` (one row per answer).", "", "## Final accuracy and questions", ""]
+             "`questionnaire.csv` (one row per answer).", ""]
+    simulated, real = tables.simulated_sessions()
+    if simulated:
+        lines += [f"**{'All' if not real else simulated} of the {simulated + real} recorded sessions "
+                  f"{'are' if simulated != 1 else 'is'} simulated: a scripted teacher played the participant "
+                  "(study run --simulated), a dry run of the pipeline, not data.** The `simulated` column of both "
+                  "tables says which.", ""]
+    lines += ["## Final accuracy and questions", ""]
     rows = []
     for name in names:
         group = [rows_ for (p, c), rows_ in sessions.items() if c == name and p in final[name]]
@@ -208,8 +228,8 @@ def order_lines(study, tables, final) -> list[str]:
     test = paired_test("first", first, "later", {p: float(np.mean(v)) for p, v in later.items() if v})
     return (["## Order effects", ""] + _table(["session position", "n", "final accuracy (mean)"], rows) +
             ["", f"First session against the mean of the later ones: n = {test.n}, median difference "
-             f"{_fmt(test.median_difference)}, W = {_fmt(test.statistic)}, p = {_fmt(test.p)}, "
-             f"r = {test.effect:+.2f}."])
+             f"{_fmt(test.median_difference, '+.3f')}, W = {_fmt(test.statistic, '.1f')}, p = {_p(test.p)}, "
+             f"r = {_fmt(test.effect, '+.2f')}."])
 
 
 def missing_lines(tables) -> list[str]:

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import shlex
 import sys
 from dataclasses import dataclass, field
 
@@ -56,13 +57,16 @@ class ParticipantRun:
     """The terminal side of one participant's run: what they read, what they type, and the files it writes."""
 
     def __init__(self, study, participant: str, simulated: bool, input_stream=None, output_stream=None,
-                 viewer: bool | None = None):
+                 viewer: bool | None = None, continue_command: str | None = None):
         self.study, self.participant, self.simulated = study, study.check_participant(participant), simulated
         self.order = assigned_orders(study)[participant]
         self.input_stream = input_stream if input_stream is not None else sys.stdin
         self.out = output_stream if output_stream is not None else sys.stdout
         self.reader = LineReader(self.input_stream)
         self.viewer = viewer
+        self.continue_command = continue_command or shlex.join(  # what the "continue with" line says
+            ["teachbot", "study", "run", str(study.path), "--participant", participant]
+            + (["--simulated"] if simulated else []))
 
     def write(self, text: str, end: str = "\n") -> None:
         print(text, end=end, file=self.out, flush=True)
@@ -157,8 +161,7 @@ class ParticipantRun:
                 self.read_line()
             finished = self.teach(files, settings, condition, resume=state.state == "running")
             if not finished:
-                self.write(f"Session saved. Continue with: teachbot study run {self.study.path} --participant "
-                           f"{self.participant}" + (" --simulated" if self.simulated else ""))
+                self.write(f"Session saved. Continue with: {self.continue_command}")
                 return 130 if finished is None else 0
         if self.study.items:
             header = settings.study

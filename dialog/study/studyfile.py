@@ -77,6 +77,7 @@ class Study:
     items: tuple[Item, ...]
     simulated_teacher: dict
     pause: str
+    simulated: bool = False  # a dry run (study run --simulated): every record it writes says so
 
     def condition(self, name: str) -> Condition:
         for condition in self.conditions:

@@ -12,9 +12,9 @@ from dialog.study import questionnaire
 from dialog.study.files import read_transcript_checked, session_files, study_header
 from dialog.study.status import Cell, study_cells
 
-TURN_COLUMNS = ("participant", "condition", "order", "state", "turn", "action", "cost", "answer", "answer_seconds",
-                "refused", "accuracy")
-ANSWER_COLUMNS = ("participant", "condition", "order", "item", "kind", "value")
+TURN_COLUMNS = ("participant", "condition", "order", "simulated", "state", "turn", "action", "cost", "answer",
+                "answer_seconds", "refused", "accuracy")
+ANSWER_COLUMNS = ("participant", "condition", "order", "simulated", "item", "kind", "value")
 COMMAND_WORDS = frozenset({"help", "?", "why", "more", "undo"})  # lines that ask something rather than answer
 
 
@@ -25,11 +25,24 @@ def refused_attempts(answer: dict) -> int:
     return sum(line.strip().lower() not in COMMAND_WORDS for line in lines[:len(lines) - taken])
 
 
+def recorded_as_simulated(study_table: dict, written_before: bool) -> bool:
+    """Whether a record's study table says a scripted teacher played the participant; ``written_before`` answers
+    for records written before the table had the field."""
+    return bool(study_table.get("simulated", written_before))
+
+
 @dataclass
 class StudyTables:
     cells: list[Cell]
     turns: list[dict]
     answers: list[dict]
+
+    def simulated_sessions(self) -> tuple[int, int]:
+        """(simulated, real): the sessions with a record that says it was simulated, and those with one that says
+        it was not (a session whose transcript and questionnaire disagree counts in both)."""
+        sessions = {flag: {(row["participant"], row["condition"]) for row in self.turns + self.answers
+                           if row["simulated"] == flag} for flag in (True, False)}
+        return len(sessions[True]), len(sessions[False])
 
 
 def collect(study) -> StudyTables:
@@ -39,17 +52,23 @@ def collect(study) -> StudyTables:
         files = session_files(study, cell.participant, cell.position, cell.condition)
         key = {"participant": cell.participant, "condition": cell.condition, "order": cell.position}
         if files.transcript.exists() and files.transcript.stat().st_size > 0:
-            _, records = read_transcript_checked(files, study_header(study, cell.participant, cell.condition,
-                                                                     cell.position))
+            header, records = read_transcript_checked(files, study_header(study, cell.participant, cell.condition,
+                                                                          cell.position))
+            scripted = (header.get("teacher") or {}).get("kind") == "scripted"
+            simulated = recorded_as_simulated(header.get("study", {}), scripted)
             for record in records:
                 answer = record.get("answer") or {}
-                turns.append({**key, "state": cell.state.state, "turn": record["turn"],
+                turns.append({**key, "simulated": simulated, "state": cell.state.state, "turn": record["turn"],
                               "action": record["action"]["kind"], "cost": record.get("cost", 0.0),
                               "answer": answer.get("kind", "none"), "answer_seconds": answer.get("seconds", 0.0),
                               "refused": refused_attempts(answer), "accuracy": record.get("accuracy")})
         if files.questionnaire.exists():
-            for row in questionnaire.load(files.questionnaire)[1]:
-                answers.append({**key, "item": row["item"], "kind": row["kind"], "value": row["value"]})
+            header, rows = questionnaire.load(files.questionnaire)
+            simulated = recorded_as_simulated(header, any(t["simulated"] for t in turns if t["participant"] ==
+                                                          cell.participant and t["condition"] == cell.condition))
+            for row in rows:
+                answers.append({**key, "simulated": simulated, "item": row["item"], "kind": row["kind"],
+                                "value": row["value"]})
     return StudyTables(cells, turns, answers)
 
 

@@ -2,6 +2,7 @@
 
 import json
 import os
+import shlex
 import sys
 from pathlib import Path
 
@@ -83,7 +84,7 @@ def test_a_participant_runs_a_session_and_a_questionnaire_at_the_terminal(tmp_pa
     child.sendline("")
     assert next_question(child) == "label"
     child.sendeof()  # the participant leaves mid-session: it is saved and resumes later
-    child.expect_exact("Continue with: teachbot study run study.toml --participant T01")
+    child.expect_exact("Continue with: teachbot study run study.toml --participant T01 --no-viewer")
     child.expect(pexpect.EOF)
     child.close()
     assert child.exitstatus == 0
@@ -130,3 +131,24 @@ def test_a_participant_runs_a_session_and_a_questionnaire_at_the_terminal(tmp_pa
     again.expect(pexpect.EOF)
     again.close()
     assert again.exitstatus == 2 and "already done every session" in again.before
+
+
+def test_the_continue_line_repeats_the_folder_and_runs_as_printed(tmp_path):
+    """Issue 23 case 5: the printed command dropped --folder, so it went to the default folder and said done."""
+    (tmp_path / "study.toml").write_text(STUDY)
+    child = spawn_study(tmp_path, "run", "study.toml", "--participant", "T02", "--folder", "pilot", "--no-viewer")
+    child.expect_exact("Press Enter to begin.")
+    child.sendline("")
+    assert next_question(child) == "label"
+    child.sendeof()
+    child.expect(r"Continue with: (teachbot study run [^\r\n]+)")
+    printed = child.match.group(1).strip()
+    child.expect(pexpect.EOF)
+    assert printed == "teachbot study run study.toml --participant T02 --folder pilot --no-viewer"
+    words = shlex.split(printed)
+    again = pexpect.spawn(TEACHBOT, words[1:], cwd=str(tmp_path), env=dict(os.environ, TERM="dumb", NO_COLOR="1"),
+                          encoding="utf-8", timeout=120, dimensions=(50, 200))
+    again.expect_exact("(This session was interrupted after 0 turns; it goes on from there.)")
+    again.sendeof()
+    again.expect(pexpect.EOF)
+    assert (tmp_path / "pilot" / "T02" / "1-quiet.jsonl").exists() and not (tmp_path / "records").exists()

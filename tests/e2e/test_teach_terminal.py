@@ -62,3 +62,22 @@ def test_a_person_teaches_at_the_terminal(tmp_path):
     assert (tmp_path / first_label["picture"]).exists()
     fields = {"turn", "time", "action", "question", "answer", "cost", "budget_left", "scene_id", "model"}
     assert all(fields <= set(record) for record in records)
+
+
+def test_the_continue_line_repeats_unrecorded_options_and_runs_as_printed(tmp_path):
+    """Issue 23 case 5: every "continue with" line repeats the options its transcript does not record."""
+    import shlex
+
+    child = spawn("--turns", "3", "--transcript", "my session.jsonl", "--pictures", "pics", cwd=tmp_path)
+    next_question(child)
+    child.sendeof()
+    child.expect(r"Continue it with: (teachbot teach [^\r\n]+)")
+    printed = child.match.group(1).strip()
+    child.expect(pexpect.EOF)
+    assert printed == "teachbot teach --resume 'my session.jsonl' --pictures pics"
+    again = spawn(*shlex.split(printed)[2:], cwd=tmp_path)
+    again.expect_exact("Transcript: my session.jsonl")
+    next_question(again)
+    again.sendeof()
+    again.expect(pexpect.EOF)
+    assert (tmp_path / "pics").is_dir() and (tmp_path / "my session.jsonl").exists()

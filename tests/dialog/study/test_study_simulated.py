@@ -38,7 +38,7 @@ def test_every_session_is_recorded_with_the_study_header(folder):
             files = session_files(study, participant, position, name)
             header, records = read_session(files.transcript)
             assert header["study"] == {"study": "example", "participant": participant, "condition": name,
-                                       "order": position, "software": "teachbot 0.1.0"}
+                                       "order": position, "software": "teachbot 0.1.0", "simulated": True}
             assert header["strategy"] == study.condition(name).strategy
             assert len(records) == study.condition(name).turns
             lines = files.questionnaire.read_text().splitlines()
@@ -145,3 +145,39 @@ def test_a_transcript_moved_to_another_session_is_refused(folder, tmp_path, caps
     assert study_cli(copy, "status") == 2
     error = capsys.readouterr().err
     assert str(first) in error and "was the file moved or renamed?" in error
+
+
+def test_a_dry_run_goes_to_its_own_folder_and_says_simulated_everywhere(tmp_path, monkeypatch, capsys):
+    """Issue 23 case 4: --simulated wrote where real participants go, and nothing said the sessions were simulated."""
+    monkeypatch.chdir(tmp_path)
+    assert main(["study", "run", str(EXAMPLE), "--participant", "P01", "--simulated", "--no-viewer"]) == 0
+    real, dry = Path("runs/studies/example"), Path("runs/studies/example-simulated")
+    assert (dry / "P01").is_dir() and not real.exists()
+    assert main(["study", "report", str(EXAMPLE), "--simulated"]) == 0
+    with open(dry / "report" / "turns.csv") as handle:
+        assert {row["simulated"] for row in csv.DictReader(handle)} == {"True"}
+    with open(dry / "report" / "questionnaire.csv") as handle:
+        assert {row["simulated"] for row in csv.DictReader(handle)} == {"True"}
+    assert "**All of the 3 recorded sessions are simulated" in (dry / "report" / "report.md").read_text()
+
+
+def test_a_report_over_simulated_and_real_sessions_refuses_unless_asked(folder, tmp_path, capsys):
+    copy = tmp_path / "records"
+    shutil.copytree(folder, copy)
+    first = assigned_orders(dataclasses.replace(load_study(EXAMPLE), folder=copy))["P01"][0]
+    real = copy / "P01" / f"1-{first}.jsonl"
+    lines = real.read_text().splitlines()
+    header = json.loads(lines[0])
+    header["session"]["study"]["simulated"] = False  # as a participant's own session would record it
+    real.write_text("\n".join([json.dumps(header)] + lines[1:]) + "\n")
+    answers = real.with_name(f"1-{first}-questionnaire.jsonl")
+    lines = answers.read_text().splitlines()
+    header = json.loads(lines[0])
+    header["questionnaire"]["simulated"] = False
+    answers.write_text("\n".join([json.dumps(header)] + lines[1:]) + "\n")
+    capsys.readouterr()
+    assert study_cli(copy, "report", "--out", str(tmp_path / "report")) == 2
+    error = capsys.readouterr().err.strip()
+    assert "holds 8 simulated (dry-run) and 1 real sessions" in error and "--allow-mixed" in error
+    assert study_cli(copy, "report", "--out", str(tmp_path / "report"), "--allow-mixed") == 0
+    assert "**8 of the 9 recorded sessions are simulated" in (tmp_path / "report" / "report.md").read_text()
