@@ -49,19 +49,18 @@ def completed_orders(study, cells: list[Cell]) -> list[tuple[str, ...]]:
 
 
 def status_text(study) -> str:
+    """One line per participant ("dt-task: done" per session, in their order), then the counts and the balance."""
     cells = study_cells(study)
     names = [c.name for c in study.conditions]
-    width = max(12, *(len(n) + 2 for n in names))
+    shown = {id(c): f"{c.condition}: {_shown(c.state, study.condition(c.condition).turns)}" for c in cells}
+    width = max(len(text) for text in shown.values()) + 2 if shown else 12
     lines = [f"Study '{study.name}' ({study.path}), records in {study.folder}",
-             "participant  " + "".join(f"{f'{p}. ':>4}{'':<{width - 4}}" for p in range(1, len(names) + 1))]
+             "participant  " + "".join(f"{f'{p}.':<{width}}" for p in range(1, len(names) + 1)).rstrip()]
     by_participant: dict[str, list[Cell]] = {}
     for cell in cells:
         by_participant.setdefault(cell.participant, []).append(cell)
     for participant, row in by_participant.items():
-        shown = "".join(f"{cell.condition + ':':<{width}}"[:width] for cell in row)
-        lines.append(f"{participant:<13}{shown}")
-        lines.append(f"{'':<13}" + "".join(f"{_shown(c.state, study.condition(c.condition).turns):<{width}}"
-                                            for c in row))
+        lines.append((f"{participant:<13}" + "".join(f"{shown[id(c)]:<{width}}" for c in row)).rstrip())
     counts = {state: sum(c.state.state == state for c in cells) for state in
               ("done", "running", "questionnaire", "aborted", "missing")}
     lines.append("sessions: " + ", ".join(f"{count} {state}" for state, count in counts.items()))
@@ -79,5 +78,5 @@ def status_text(study) -> str:
     if not result.positions_balanced:
         for name in names:
             counts = [result.positions[(name, p)] for p in range(1, len(names) + 1)]
-            lines.append(f"  {name}: at positions 1..{len(names)} {counts} times")
+            lines.append(f"  {name}: at positions 1..{len(names)}: " + ", ".join(str(c) for c in counts) + " times")
     return "\n".join(lines)

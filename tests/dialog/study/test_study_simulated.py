@@ -93,6 +93,9 @@ def test_status_and_report_of_a_partly_run_study(folder, tmp_path, capsys):
     status = capsys.readouterr().out
     assert "9 done" in status and "1 aborted" in status and "fire alarm" in status
     assert "orders of the 3 participants who finished every session: positions balanced, carry-over not" in status
+    rows = [line for line in status.splitlines() if line.startswith("P0")]
+    assert len(rows) == 6 and all(line.count(": ") == 3 for line in rows)  # one line per participant, no wrapping
+    assert "ABORTED" in rows[3] and max(len(line) for line in rows) <= 100
 
     assert study_cli(copy, "report", "--out", str(tmp_path / "report")) == 0
     report = tmp_path / "report"
