@@ -20,6 +20,7 @@ from dialog.questions import Prompt
 
 MAX_LINE_BYTES = 4 << 20  # a longer "line" is handed over as it is, the rest read as the next line
 TIMEOUT = object()
+COUNTDOWN_MARKS = (30, 10, 5)  # real-time mode: the seconds left at which the prompt says so again
 
 
 class LineReader:
@@ -109,16 +110,28 @@ class TerminalTeacher:
         """A line from the session itself (progress, the summary)."""
         self.console.print(text)
 
+    def _prompt(self, seconds_left: float | None) -> None:
+        self.console.print(_prompt_text(seconds_left), end="")
+        self.console.file.flush()
+
     def tell(self, text: str) -> None:
         self.console.print(f"Robot: {text}", style="cyan")
 
     def listen(self, prompt: Prompt, deadline: float | None) -> str | None:
-        self.console.print("> ", end="")
-        self.console.file.flush()
+        """One line typed by the person; in real-time mode the prompt counts down ("[23 s left] > ") and says
+        again how long is left at each of COUNTDOWN_MARKS seconds."""
         timeout = None
         if deadline is not None and self.clock is not None:
             timeout = deadline - self.clock.now()
-        line = self.reader.readline(timeout)
+        self._prompt(timeout)
+        marks = [mark for mark in COUNTDOWN_MARKS if timeout is not None and mark < timeout]
+        while True:
+            line = self.reader.readline(None if timeout is None else max(timeout - (marks[0] if marks else 0), 0))
+            if line is not TIMEOUT or not marks:
+                break
+            timeout = marks.pop(0)  # as scheduled: a virtual clock does not move while we wait
+            self.console.print()
+            self._prompt(timeout)
         if line is TIMEOUT:
             self._missed = True
             self.console.print()
@@ -128,6 +141,10 @@ class TerminalTeacher:
         elif self.reader.fd is None or not _echoes(self.reader.fd):
             self.console.print(line[:200] + (" ..." if len(line) > 200 else ""), style="dim")
         return line
+
+
+def _prompt_text(seconds_left: float | None) -> str:
+    return "> " if seconds_left is None else f"[{max(seconds_left, 0):.0f} s left] > "
 
 
 def _echoes(fd: int) -> bool:

@@ -74,6 +74,22 @@ def test_a_deadline_passes_without_waiting_and_stale_lines_are_dropped(scene):
     stream.close()
 
 
+def test_real_time_mode_counts_down_at_the_prompt(scene, monkeypatch):
+    """Issue 23 case 11: real-time mode said how long there was only once, above the question."""
+    import re
+
+    import dialog.terminal
+    monkeypatch.setattr(dialog.terminal, "COUNTDOWN_MARKS", (1.4, 0.6))
+    stream, write_fd = make_pipe(b"")
+    out = io.StringIO()
+    clock = VirtualClock(0.0)
+    teacher = TerminalTeacher(stream, out, clock=clock)
+    converse(teacher, prompt(scene, LabelQuery(0), deadline=2.0), AnswerParser(CONCEPTS), clock)  # waits 2 s
+    assert re.findall(r"\[(\d+) s left\] > ", out.getvalue()) == ["2", "1", "1"]
+    os.close(write_fd)
+    stream.close()
+
+
 def hostile_inputs(count: int, seed: int = 0) -> list[bytes]:
     """Random and hostile answer lines (no newline inside): unicode, control bytes, empty, huge, tricky."""
     rng = np.random.default_rng(seed)
