@@ -2,15 +2,20 @@
 
 The thesis compares strategies with the Mann-Whitney U test on per-data-set
 accuracies (eq. 6.4 averages over k training sets); curves are summarised by
-their mean and standard error at each point.
+their mean and standard error at each point. Where every strategy plays the
+same episodes (same pools, seeds and scenes) the comparison is paired: the
+Wilcoxon signed-rank test over the shared episodes, its matched-pairs
+rank-biserial effect size, a cluster bootstrap interval of the mean
+difference (episodes of one pool are not independent), and Holm's correction
+over the findings of one table.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
-from scipy.stats import mannwhitneyu
+from scipy.stats import mannwhitneyu, rankdata, wilcoxon
 
 ALTERNATIVES = ("two-sided", "greater", "less")
 
@@ -28,10 +33,103 @@ class Comparison:
     mean_b: float
     n_a: int
     n_b: int
+    p_holm: float | None = None  # Holm-adjusted over the findings of one table (None: not adjusted)
 
     @property
     def significant(self) -> bool:
-        return self.p < 0.05
+        return (self.p if self.p_holm is None else self.p_holm) < 0.05
+
+
+@dataclass(frozen=True)
+class PairedComparison:
+    """Wilcoxon signed-rank of ``a`` against ``b`` over ``n`` paired episodes (``greater``: a tends to exceed b),
+    the matched-pairs rank-biserial ``effect`` r, the median and mean differences, and a 95 % cluster-bootstrap
+    interval ``ci`` of the mean difference a - b."""
+
+    a: str
+    b: str
+    alternative: str
+    statistic: float  # W: the signed-rank statistic scipy reports (NaN when the test cannot be run)
+    p: float
+    mean_a: float
+    mean_b: float
+    n: int
+    median_difference: float
+    effect: float
+    ci: tuple[float, float]
+    clusters: int  # independent units the interval resampled (pools x data seeds)
+    p_holm: float | None = None
+
+    @property
+    def significant(self) -> bool:
+        return (self.p if self.p_holm is None else self.p_holm) < 0.05
+
+
+def rank_biserial(differences) -> float:
+    """Matched-pairs rank-biserial r = (R+ - R-) / (R+ + R-) over the ranks of the non-zero |differences|
+    (0 when all are zero): +1 when every pair favours a."""
+    d = np.asarray(differences, dtype=float)
+    d = d[d != 0]
+    if len(d) == 0:
+        return 0.0
+    ranks = rankdata(np.abs(d))
+    plus, minus = ranks[d > 0].sum(), ranks[d < 0].sum()
+    return float((plus - minus) / (plus + minus))
+
+
+def cluster_bootstrap_ci(differences, clusters, rng: np.random.Generator, resamples: int = 2000,
+                         level: float = 0.95) -> tuple[float, float]:
+    """Percentile interval of the mean of ``differences`` when whole clusters (e.g. training pools of one data
+    seed, whose episodes share data) are resampled with replacement; a single cluster gives (mean, mean)."""
+    d = np.asarray(differences, dtype=float)
+    clusters = list(clusters)
+    first_seen = {label: i for i, label in enumerate(dict.fromkeys(clusters))}  # any hashable label, in order
+    labels = np.asarray([first_seen[label] for label in clusters], dtype=int)
+    if len(d) != len(labels) or len(d) == 0:
+        raise ValueError(f"one cluster per difference is needed ({len(d)} differences, {len(labels)} clusters)")
+    units = np.unique(labels)
+    sums = np.array([d[labels == u].sum() for u in units])
+    counts = np.array([np.sum(labels == u) for u in units])
+    if len(units) == 1:
+        return float(d.mean()), float(d.mean())
+    picks = rng.integers(0, len(units), size=(resamples, len(units)))
+    means = sums[picks].sum(axis=1) / counts[picks].sum(axis=1)
+    tail = (1.0 - level) / 2.0
+    return float(np.quantile(means, tail)), float(np.quantile(means, 1.0 - tail))
+
+
+def wilcoxon_paired(name_a: str, a, name_b: str, b, alternative: str = "two-sided", clusters=None,
+                    rng: np.random.Generator | None = None) -> PairedComparison:
+    """Wilcoxon signed-rank test of paired samples ``a`` and ``b`` (one value each per shared episode), zero
+    differences dropped as in Wilcoxon's original test; ``clusters`` (one label per pair) for the interval."""
+    if alternative not in ALTERNATIVES:
+        raise ValueError(f"alternative must be one of {', '.join(ALTERNATIVES)}, got '{alternative}'")
+    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+    if len(a) != len(b) or len(a) < 1:
+        raise ValueError(f"paired samples need the same number of values, at least one ({name_a}: {len(a)}, "
+                         f"{name_b}: {len(b)})")
+    d = a - b
+    if np.all(d == 0) or len(d) < 2:
+        statistic, p = float("nan"), 1.0  # no pair differs: no evidence either way
+    else:
+        result = wilcoxon(a, b, zero_method="wilcox", alternative=alternative)
+        statistic, p = float(result.statistic), float(result.pvalue)
+    rng = rng if rng is not None else np.random.default_rng(0)
+    labels = list(range(len(d))) if clusters is None else list(clusters)
+    ci = cluster_bootstrap_ci(d, labels, rng)
+    return PairedComparison(name_a, name_b, alternative, statistic, p, float(a.mean()), float(b.mean()), len(d),
+                            float(np.median(d)), rank_biserial(d), ci, len(set(labels)))
+
+
+def holm(comparisons: list) -> list:
+    """The comparisons with ``p_holm`` set: Holm's step-down adjustment over all of them (family-wise 5 %)."""
+    m = len(comparisons)
+    order = sorted(range(m), key=lambda i: comparisons[i].p)
+    adjusted, running = [0.0] * m, 0.0
+    for rank, index in enumerate(order):
+        running = max(running, min(1.0, (m - rank) * comparisons[index].p))
+        adjusted[index] = running
+    return [replace(c, p_holm=adjusted[i]) for i, c in enumerate(comparisons)]
 
 
 def mann_whitney(name_a: str, a, name_b: str, b, alternative: str = "two-sided") -> Comparison:

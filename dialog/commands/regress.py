@@ -89,7 +89,8 @@ def run(args: argparse.Namespace) -> int:
         report = kind.report(outcome, out)[0]
     print(f"{suite.name}: {outcome.count} runs in {outcome.seconds:.1f} s; report {report}")
     for finding in outcome.findings:
-        ps = ", ".join(f"{c.b} p={c.p:.3g}" for c in finding.comparisons)
+        ps = ", ".join(f"{c.b} p={c.p:.3g}" + ("" if c.p_holm is None else f" (Holm {c.p_holm:.3g})")
+                       for c in finding.comparisons)
         print(f"  {finding.finding.id}: {finding.verdict}" + (f" ({ps})" if ps else ""))
     if args.update_baseline:
         with writing(baseline_path(suite), "baseline"):

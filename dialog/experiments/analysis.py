@@ -8,7 +8,17 @@ from dataclasses import dataclass
 import numpy as np
 
 from dialog.experiments.suite import Finding, Suite
-from learning.significance import Comparison, accuracy_after_questions, mann_whitney, mean_and_standard_error
+from learning.significance import (
+    Comparison,
+    PairedComparison,
+    accuracy_after_questions,
+    holm,
+    mann_whitney,
+    mean_and_standard_error,
+    wilcoxon_paired,
+)
+
+BOOTSTRAP_SEED = 20260  # the cluster bootstrap's own stream: the same results give the same intervals
 
 
 def condition_checkpoints(suite: Suite, turns: float) -> tuple[int, ...]:
@@ -54,6 +64,7 @@ class CheckpointSummary:
     mean: np.ndarray
     error: np.ndarray
     values: np.ndarray  # (episodes x checkpoints)
+    keys: tuple = ()  # per episode (data seed, data set, seed): what pairs it with another strategy's episode
 
 
 def summarise(results: list[dict], suite: Suite) -> list[CheckpointSummary]:
@@ -64,7 +75,8 @@ def summarise(results: list[dict], suite: Suite) -> list[CheckpointSummary]:
         checkpoints = suite.checkpoints if limit is None else condition_checkpoints(suite, limit)
         values = np.vstack([checkpoint_values(r, suite, checkpoints) for r in group]).reshape(len(group), -1)
         mean, error = mean_and_standard_error(values)
-        summaries.append(CheckpointSummary(condition, strategy, checkpoints, mean, error, values))
+        keys = tuple((r["spec"].get("data_seed", 0), r["spec"]["dataset"], r["spec"]["seed"]) for r in group)
+        summaries.append(CheckpointSummary(condition, strategy, checkpoints, mean, error, values, keys))
     return summaries
 
 
@@ -73,7 +85,7 @@ class FindingResult:
     """A finding's tests; a finding that could not be tested has no comparisons and says why in ``skipped``."""
 
     finding: Finding
-    comparisons: tuple[Comparison, ...]
+    comparisons: tuple[Comparison | PairedComparison, ...]
     skipped: str = ""
 
     @property
@@ -97,28 +109,48 @@ def skipped_by_overrides(original: Suite, suite: Suite) -> list[FindingResult]:
 
 
 def evaluate_findings(summaries: list[CheckpointSummary], suite: Suite) -> list[FindingResult]:
-    """One-tailed (or as the suite says) Mann-Whitney tests of each finding at its checkpoint.
+    """Each finding tested at its checkpoint as the suite says (one-tailed by default), then Holm's correction
+    over every comparison of the suite's findings (the planned tests of one table).
 
-    A finding whose checkpoint lies beyond its condition's turns, or whose strategies have no
-    results, comes back skipped with the reason (the episodes kind checks checkpoints on loading).
+    Strategies that played the same episodes (every episodes suite: same pools, seeds, scenes) are compared
+    paired, by the Wilcoxon signed-rank test over the shared episodes with a cluster bootstrap interval over
+    the pools; summaries without episode keys (chapter 5's users) by Mann-Whitney U. A finding whose
+    checkpoint lies beyond its condition's turns, or whose strategies have no results, is skipped with the reason.
     """
     lookup = {(s.condition, s.strategy): s for s in summaries}
-    outcomes = []
+    outcomes, tested = [], []
     for finding in suite.findings:
         reason = _untestable(finding, lookup, suite)
         if reason:
             outcomes.append(FindingResult(finding, (), reason))
             continue
-        better_summary = lookup[(finding.condition, finding.better)]
-        column = better_summary.checkpoints.index(finding.at)
-        better = better_summary.values[:, column]
-        comparisons = []
-        for other in finding.than:
-            values = lookup[(finding.condition, other)].values[:, column]
-            comparisons.append(mann_whitney(finding.better, _finite(better), other, _finite(values),
-                                            finding.alternative))
-        outcomes.append(FindingResult(finding, tuple(comparisons)))
+        better = lookup[(finding.condition, finding.better)]
+        column = better.checkpoints.index(finding.at)
+        comparisons = tuple(compare(better, lookup[(finding.condition, other)], column, finding.alternative)
+                            for other in finding.than)
+        outcomes.append(FindingResult(finding, comparisons))
+        tested.append(len(outcomes) - 1)
+    adjusted = iter(holm([c for index in tested for c in outcomes[index].comparisons]))
+    for index in tested:
+        outcome = outcomes[index]
+        outcomes[index] = FindingResult(outcome.finding, tuple(next(adjusted) for _ in outcome.comparisons))
     return outcomes
+
+
+def compare(first: CheckpointSummary, second: CheckpointSummary, column: int,
+            alternative: str = "two-sided") -> Comparison | PairedComparison:
+    """``first`` against ``second`` at one checkpoint: paired over their shared episodes where both have episode
+    keys (clustered by data seed and pool), else Mann-Whitney U over the episodes that reached it."""
+    if first.keys and second.keys:
+        mine = {key: value for key, value in zip(first.keys, first.values[:, column]) if np.isfinite(value)}
+        theirs = {key: value for key, value in zip(second.keys, second.values[:, column]) if np.isfinite(value)}
+        shared = [key for key in first.keys if key in mine and key in theirs]
+        if shared:
+            return wilcoxon_paired(first.strategy, [mine[k] for k in shared], second.strategy,
+                                   [theirs[k] for k in shared], alternative, clusters=[k[:2] for k in shared],
+                                   rng=np.random.default_rng(BOOTSTRAP_SEED))
+    return mann_whitney(first.strategy, _finite(first.values[:, column]), second.strategy,
+                        _finite(second.values[:, column]), alternative)
 
 
 def _untestable(finding: Finding, lookup: dict, suite: Suite) -> str:
@@ -136,15 +168,11 @@ def _untestable(finding: Finding, lookup: dict, suite: Suite) -> str:
     return ""
 
 
-def pairwise(summaries: list[CheckpointSummary], condition: str, column: int) -> list[Comparison]:
-    """Two-sided Mann-Whitney between every pair of strategies in one condition at one checkpoint."""
+def pairwise(summaries: list[CheckpointSummary], condition: str, column: int) -> list:
+    """Two-sided tests between every pair of strategies in one condition at one checkpoint (exploratory:
+    uncorrected, reported apart from the planned findings)."""
     group = [s for s in summaries if s.condition == condition]
-    comparisons = []
-    for i, first in enumerate(group):
-        for second in group[i + 1:]:
-            comparisons.append(mann_whitney(first.strategy, _finite(first.values[:, column]), second.strategy,
-                                            _finite(second.values[:, column])))
-    return comparisons
+    return [compare(first, second, column) for i, first in enumerate(group) for second in group[i + 1:]]
 
 
 def _finite(values: np.ndarray) -> np.ndarray:

@@ -10,6 +10,7 @@ import numpy as np
 from dialog.experiments.analysis import CheckpointSummary, FindingResult, group_results, pairwise
 from dialog.experiments.episodes import SERIES
 from dialog.experiments.suite import Suite
+from learning.significance import PairedComparison
 
 
 def write_episode_csvs(results: list[dict], out: Path) -> Path:
@@ -37,7 +38,34 @@ def write_episode_csvs(results: list[dict], out: Path) -> Path:
 
 
 def _fmt_p(p: float) -> str:
+    """A p value: 3 significant digits, scientific below 1e-4 (one format for the whole column)."""
     return f"{p:.3g}" if p >= 1e-4 else f"{p:.1e}"
+
+
+PLANNED_NOTE = ("Every strategy played the same episodes (the same pools, seeds and scenes), so each comparison is "
+                "paired: the Wilcoxon signed-rank test over the shared episodes (n pairs), the matched-pairs "
+                "rank-biserial r, the median difference, and a 95 % interval of the mean difference from a cluster "
+                "bootstrap over the training pools and data seeds (the independent units; episodes of one pool "
+                "share its data). A finding holds when every one of its comparisons is significant after Holm's "
+                "correction over all the comparisons in this table.")
+
+
+def _paired_cells(c) -> str:
+    """n | median diff | r | CI | W for a paired comparison; the unpaired Mann-Whitney's n and U otherwise."""
+    if isinstance(c, PairedComparison):
+        low, high = c.ci
+        return (f"{c.n} | {c.median_difference:+.3f} | {c.effect:+.2f} | [{low:+.3f}, {high:+.3f}] "
+                f"({c.clusters} clusters) | {c.statistic:.1f}")
+    return f"{c.n_a} + {c.n_b} | – | – | – | U {c.u:.1f}"
+
+
+def comparison_table(comparisons: list, at: str) -> list[str]:
+    """Markdown rows of two-sided comparisons between pairs of strategies (paired where they share episodes)."""
+    lines = [f"| a | b | mean a {at} | mean b {at} | n | median diff | r | 95 % CI of the mean diff | W | p |",
+             "|---" * 10 + "|"]
+    for c in comparisons:
+        lines.append(f"| {c.a} | {c.b} | {c.mean_a:.3f} | {c.mean_b:.3f} | {_paired_cells(c)} | {_fmt_p(c.p)} |")
+    return lines
 
 
 def skipped_findings_lines(findings: list[FindingResult]) -> list[str]:
@@ -133,21 +161,20 @@ def markdown_report(suite: Suite, results: list[dict], summaries: list[Checkpoin
                 cells += f" | {turns:.1f} turns, {np.mean([r['series']['seconds'][-1] for r in group]):.0f} s"
             lines.append(f"| {summary.strategy} | {cells} | {questions:.1f} | {demo_cost:.0%} |")
         column = len(checkpoints) - 1
-        lines += ["", f"Two-sided Mann-Whitney U between strategies after {checkpoints[column]} {axis_name}:", "",
-                  f"| a | b | mean a after {checkpoints[column]} | mean b after {checkpoints[column]} | U | p |",
-                  "|---|---|---|---|---|---|"]
-        for c in pairwise(summaries, condition.name, column):
-            lines.append(f"| {c.a} | {c.b} | {c.mean_a:.3f} | {c.mean_b:.3f} | {c.u:.1f} | {_fmt_p(c.p)} |")
+        lines += ["", f"Exploratory (not corrected, not planned): two-sided tests between every pair of strategies "
+                      f"after {checkpoints[column]} {axis_name}.", ""]
+        lines += comparison_table(pairwise(summaries, condition.name, column), f"after {checkpoints[column]}")
         lines.append("")
     if findings:
-        lines += ["## The thesis's findings, tested here", "",
-                  "| finding | condition | compared after | comparison | mean | U | p (one-tailed) | holds? |",
-                  "|---|---|---|---|---|---|---|---|"]
+        lines += ["## The thesis's findings, tested here (planned)", "", PLANNED_NOTE, "",
+                  "| finding | condition | compared after | comparison | mean | n | median diff | r | 95 % CI of "
+                  "the mean diff | W | p (one-tailed) | p (Holm) | holds? |", "|---" * 13 + "|"]
         for outcome in findings:
             f = outcome.finding
             for c in outcome.comparisons:
                 lines.append(f"| {f.id}: {f.text} | {f.condition} | {f.at} {axis_name} | {c.a} > {c.b} | "
-                             f"{c.mean_a:.3f} vs {c.mean_b:.3f} | {c.u:.1f} | {_fmt_p(c.p)} | "
+                             f"{c.mean_a:.3f} vs {c.mean_b:.3f} | {_paired_cells(c)} | {_fmt_p(c.p)} | "
+                             f"{_fmt_p(c.p_holm) if c.p_holm is not None else '–'} | "
                              f"{'yes' if c.significant else 'no'} |")
         lines += findings_closing_lines(findings, suite.analysis)
     return write_markdown(lines, out)

@@ -5,7 +5,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.stats import rankdata, wilcoxon
+from scipy.stats import wilcoxon
+
+from learning.significance import rank_biserial
 
 
 @dataclass(frozen=True)
@@ -21,17 +23,6 @@ class PairedTest:
     @property
     def runnable(self) -> bool:
         return not np.isnan(self.p)
-
-
-def rank_biserial(differences) -> float:
-    """(R+ - R-) / (R+ + R-) over the ranks of the non-zero |differences| (0 when all are zero)."""
-    d = np.asarray(differences, dtype=float)
-    d = d[d != 0]
-    if len(d) == 0:
-        return 0.0
-    ranks = rankdata(np.abs(d))
-    plus, minus = ranks[d > 0].sum(), ranks[d < 0].sum()
-    return float((plus - minus) / (plus + minus))
 
 
 def paired_test(name_a: str, a: dict, name_b: str, b: dict) -> PairedTest:

@@ -75,10 +75,16 @@ def episode(strategy, condition, turns, dataset, level, questions=None):
             "accuracy": accuracy[-1], "seconds": 0.01}
 
 
-def fake_results(suite):
+def fake_results(suite, seeds=(0, 1)):
+    """Every strategy on the same data sets and seeds (paired, as a suite's episodes are)."""
     levels = {"passive": 0.9, "active": 0.6, "random": 0.4}
-    return [episode(strategy, condition.name, condition.turns, dataset, levels.get(strategy, 0.5))
-            for condition in suite.conditions for strategy in suite.strategies for dataset in range(suite.datasets)]
+    results = [episode(strategy, condition.name, condition.turns, dataset, levels.get(strategy, 0.5))
+               for condition in suite.conditions for strategy in suite.strategies for dataset in range(suite.datasets)
+               for seed in seeds]
+    for result, seed in zip(results, [s for _ in range(len(results) // len(seeds)) for s in seeds]):
+        result["spec"]["seed"] = seed
+        result["series"]["accuracy"] = [a + 0.001 * seed for a in result["series"]["accuracy"]]
+    return results
 
 
 def test_every_kind_is_registered_and_an_unknown_kind_lists_them(tmp_path, capsys):
@@ -142,9 +148,10 @@ def test_checkpoints_beyond_a_conditions_turns_are_left_out_and_headings_name_th
     long = report.split("## Condition `long`")[1].split("## The thesis's findings")[0]
     assert "| strategy | after 2 turns | after 4 turns | questions |" in short and "after 8" not in short
     assert "(checkpoints [8] lie beyond its 4 turns)" in short
-    assert "Mann-Whitney U between strategies after 4 turns:" in short
+    assert "two-sided tests between every pair of strategies after 4 turns." in short
     assert "| strategy | after 2 turns | after 4 turns | after 8 turns |" in long
-    assert "Mann-Whitney U between strategies after 8 turns:" in long
+    assert "two-sided tests between every pair of strategies after 8 turns." in long
+    assert "(planned)" in report and "Holm" in report and "(4 clusters)" in report
     assert "late-in-short: passive beats active after 8 turns: skipped, it compares after 8 turns" in report
     assert "| late-in-long: passive beats active after 8 turns | long | 8 turns | passive > active |" in report
     bands = make_baseline(suite, summaries)["bands"]

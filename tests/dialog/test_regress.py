@@ -76,7 +76,8 @@ def test_findings_and_baseline_bands(tmp_path):
     results += [fake_result("active", [0.3, 0.4, 0.45, 0.5], [1, 2, 3, 3], d) for d in range(5)]
     summaries = summarise(results, suite)
     (finding,) = evaluate_findings(summaries, suite)
-    assert finding.holds and finding.comparisons[0].p < 0.01
+    paired = finding.comparisons[0]  # the same 5 data sets for both: paired, 5 pairs, all favour passive
+    assert finding.holds and paired.n == 5 and paired.p == pytest.approx(1 / 32) and paired.effect == 1.0
     path = write_baseline(suite, summaries, tmp_path / "base.json")
     passed = check_against_baseline(suite, summaries, path)
     assert passed == [] and passed.verdict() == "baseline check: passed (6 of 6 within bands)"
