@@ -129,7 +129,9 @@ def kitchen_name(text: str) -> str:
 def add_task_option(parser: argparse.ArgumentParser, default: str | None, help_default: str | None = None) -> None:
     """``--task NAME``, the accepted names listed in --help."""
     parser.add_argument("--task", default=default, type=task_name, metavar="TASK",
-                        help=f"task: {', '.join(task_names())} or a .toml file (default {help_default or default})")
+                        help=f"task: {', '.join(task_names())} or a .toml file (default {help_default or default}); "
+                             "scenes hold the task's interactive number of objects (pack-lunchbox: 12, where the "
+                             "thesis's experiments and regress's ch6-static and ch7-pack-lunchbox use 55)")
 
 
 def add_kitchen_option(parser: argparse.ArgumentParser, default: str | None, default_text: str | None = None,

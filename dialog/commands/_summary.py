@@ -35,3 +35,12 @@ def session_time(clock, run_seconds: float, resumed: list[dict]) -> str:
         return f"{total:.1f} s"
     before = float(resumed[-1].get("ended", resumed[-1].get("time", 0.0)))
     return f"{total:.1f} s in all ({before:.1f} s before the resume, {max(total - before, 0.0):.1f} s after)"
+
+
+def scene_size(task) -> str:
+    """"12 objects a scene (an interactive size; the thesis's experiments use 55)" for a task smaller than its
+    largest scene, else "55 objects a scene"."""
+    if task.objects_per_scene < task.max_objects_per_scene:
+        return (f"{task.objects_per_scene} objects a scene (an interactive size; the thesis's experiments use "
+                f"{task.max_objects_per_scene})")
+    return f"{task.objects_per_scene} objects a scene"

@@ -9,7 +9,7 @@ from pathlib import Path
 
 from dialog.clock import VirtualClock
 from dialog.commands._arguments import add_episode_options, add_time_options, resolve_time
-from dialog.commands._summary import questions_in_words
+from dialog.commands._summary import questions_in_words, scene_size
 from dialog.commands._viewer import add_viewer_option, hold_viewer, viewer_observers
 from dialog.commands.teach import DEFAULT_STRATEGY
 from dialog.environment import SimulatedKitchen
@@ -116,7 +116,8 @@ def _print_summary(args: argparse.Namespace, result, environment, manager) -> No
         f"time used {manager.clock.now():.0f} of {manager.config.seconds:g} s in {result.completed} turns; "
     print(f"\nAccuracy on {args.task} held-out scenes: {result.accuracy:.1%} "
           f"(chance {1 / len(environment.concepts):.0%}); budget spent {result.budget_spent:g} of {args.budget:g}; "
-          f"questions: {questions_in_words(result.queries)}; {used}{result.seconds:.1f} s. "
+          f"questions: {questions_in_words(result.queries)}; {scene_size(environment.world.task)}; "
+          f"{used}{result.seconds:.1f} s. "
           f"Transcript: {result.transcript}", flush=True)
     if args.json:
         summary = {key: asdict(result)[key] for key in SUMMARY_KEYS}

@@ -9,7 +9,7 @@ from pathlib import Path
 
 from dialog.commands._arguments import add_episode_options, add_time_options, budget, positive_seconds, resolve_time
 from dialog.commands._resume import check_resume_options, continue_command
-from dialog.commands._summary import questions_in_words, session_time
+from dialog.commands._summary import questions_in_words, scene_size, session_time
 from dialog.commands._viewer import add_viewer_option, hold_viewer, start_viewer, stop_viewer
 from dialog.environment import SimulatedKitchen
 from dialog.experiments.runner import file_label
@@ -165,7 +165,8 @@ def _teach(args, settings: SessionSettings, path: Path, lock: TranscriptLock, in
         allocation = f"{settings.turns} turns" if settings.seconds is None else \
             f"{settings.seconds:g} s with embodied costs (at most {settings.turns} turns)"
         intro = (f"Teaching '{settings.task}' ({', '.join(environment.concepts)}) in {settings.kitchen}: "
-                 f"{allocation}, budget {settings.budget:g}, strategy {settings.strategy}"
+                 f"{allocation}, budget {settings.budget:g}, {scene_size(environment.world.task)}, "
+                 f"strategy {settings.strategy}"
                  f"{'' if settings.weights is None else ' with the weights in ' + settings.weights['file']}. "
                  f"Transcript: {path}")
         if records:

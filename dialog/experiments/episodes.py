@@ -92,7 +92,8 @@ def _run_episode(spec: EpisodeSpec, strategy: Strategy | None = None) -> dict:
     scenes = -(-condition.turns // max(condition.change_every, 1))
     if condition.seconds is not None:  # embodied costs: the scenes come with time (dialog/embodied.py)
         scenes = max(1, int(-(-condition.seconds // load_embodied_costs().scene_seconds(condition.change_every))))
-    environment = PoolEnvironment(pools.train[spec.dataset], pools.test, pools.task, scenes)
+    environment = PoolEnvironment(pools.train[spec.dataset], pools.test, pools.task, scenes,
+                                  condition.objects_per_scene)
     config = spec.settings().config()
     rngs = episode_generators(spec.episode_seed)
     if strategy is None:

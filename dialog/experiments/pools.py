@@ -91,15 +91,20 @@ def state_order(task: Task) -> dict[str, tuple[str, ...]]:
 class PoolEnvironment:
     """The manager's environment over a training pool and a test pool (no arm: nothing to point with)."""
 
-    def __init__(self, train: Pool, test: Pool, task: Task, scenes_per_episode: int = 1):
+    def __init__(self, train: Pool, test: Pool, task: Task, scenes_per_episode: int = 1,
+                 objects_per_scene: int | None = None):
         concepts = task.concepts
         missing = sorted(set(concepts) - set(train.concepts.tolist()))
         if missing:
             raise SettingsError(f"training pool has no observations of {missing}")
+        size = task.objects_per_scene if objects_per_scene is None else int(objects_per_scene)
+        if not 1 <= size <= task.max_objects_per_scene:
+            raise SettingsError(f"objects_per_scene {size} is not accepted for task '{task.name}': a scene holds "
+                                f"1 to {task.max_objects_per_scene} objects")
         self.train, self.test = train, test
         self.concepts = tuple(concepts)
         self.feature_names = tuple(train.feature_names)
-        self.objects_per_scene = task.objects_per_scene
+        self.objects_per_scene = size  # thesis §6.5: 55 in pack-lunchbox's experiments, 12 in prepare-lunch's
         self.relevant_features = task.relevant_features
         self.scenes_per_episode = max(int(scenes_per_episode), 1)
         self._by_concept = {c: np.flatnonzero(train.concepts == c) for c in self.concepts}

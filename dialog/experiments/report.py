@@ -7,6 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
+from bullet_world.catalogue import load_task
 from dialog.experiments.analysis import CheckpointSummary, FindingResult, group_results, pairwise
 from dialog.experiments.episodes import SERIES
 from dialog.experiments.suite import Suite
@@ -130,11 +131,13 @@ def markdown_report(suite: Suite, results: list[dict], summaries: list[Checkpoin
              "- per-episode CSV: [episodes.csv](episodes.csv) (one row per episode, linking its per-turn CSV)", ""]
     figure_names = {path.name for path in figures}
     groups = group_results(results)
+    scene_default = load_task(suite.task).objects_per_scene
     for condition in suite.conditions:
         embodied = "" if condition.seconds is None else \
             f"embodied costs, {condition.seconds:g} s (at most {condition.turns} turns), "
         lines += [f"## Condition `{condition.name}`: budget {condition.budget:g}, "
-                  f"{embodied or f'{condition.turns} turns, '}a new scene every {condition.change_every} turns", ""]
+                  f"{embodied or f'{condition.turns} turns, '}a new scene every {condition.change_every} turns, "
+                  f"{condition.scene_size(scene_default)} objects a scene", ""]
         for stem, text in (("curves", "learning curves"), ("timing", "when each strategy asked")):
             if f"{stem}-{condition.name}.png" in figure_names:
                 lines += [f"![{text}]({stem}-{condition.name}.png)", ""]

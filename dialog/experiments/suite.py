@@ -19,9 +19,11 @@ SUITE_DIR = Path(__file__).resolve().parents[1] / "suites"
 KINDS = ("episodes", "feature-selection", "recipes")
 AXES = ("questions", "turns", "demonstrations", "seconds")
 SUITE_FIELDS = ("name", "description", "analysis", "kind", "task", "kitchen", "strategies", "datasets", "seeds",
-                "checkpoints", "axis", "costs", "teacher", "options", "dataset", "data_seed", "condition", "finding")
+                "checkpoints", "axis", "costs", "teacher", "options", "dataset", "data_seed", "condition", "finding",
+                "objects_per_scene")
 CONDITION_FIELDS = ("name", "budget", "turns", "change_every")
-CONDITION_OPTIONAL = ("seconds",)  # embodied costs: the time allocation in seconds (turns is then the cap)
+# seconds: embodied costs' time allocation (turns is then the cap); objects_per_scene: the scene size (thesis §6.5)
+CONDITION_OPTIONAL = ("seconds", "objects_per_scene")
 FINDING_FIELDS = ("id", "text", "condition", "at", "better", "than", "alternative", "than_at", "margin")
 TEACHER_KINDS = ("scripted", "oracle")
 TEACHER_RATES = ("mislabel_rate", "dont_know_rate", "feature_quality")
@@ -41,6 +43,11 @@ class Condition:
     turns: int
     change_every: int
     seconds: float | None = None  # embodied costs (thesis §8.2.2): the allocation in seconds; turns is the cap
+    objects_per_scene: int | None = None  # scene size of the episodes (None: the task's interactive default)
+
+    def scene_size(self, task_default: int) -> int:
+        """How many objects each scene of this condition holds."""
+        return task_default if self.objects_per_scene is None else self.objects_per_scene
 
 
 @dataclass(frozen=True)
@@ -172,8 +179,9 @@ def _suite(table: dict, where: str, known_strategies) -> Suite:
         unknown = [s for s in strategies if s not in known_strategies]
         if unknown:
             raise SuiteError(f"{where}: unknown strategies {unknown}; known: {', '.join(known_strategies)}")
-    conditions = tuple(_condition(c, f"{where} condition {i + 1}") for i, c in enumerate(tables(table, "condition",
-                                                                                                 where, [])))
+    scene_size = integer(table, "objects_per_scene", where, None, low=1)
+    conditions = tuple(_condition(c, f"{where} condition {i + 1}", scene_size)
+                       for i, c in enumerate(tables(table, "condition", where, [])))
     if kind == "episodes" and not conditions:
         raise SuiteError(f"{where}: an episodes suite needs at least one [[condition]]")
     names = [c.name for c in conditions]
@@ -196,11 +204,13 @@ def _suite(table: dict, where: str, known_strategies) -> Suite:
     )
 
 
-def _condition(table: dict, where: str) -> Condition:
+def _condition(table: dict, where: str, objects_per_scene: int | None = None) -> Condition:
+    """One [[condition]]; ``objects_per_scene`` is the suite's scene size, which a condition may override."""
     check_keys(table, where, required=CONDITION_FIELDS, optional=CONDITION_OPTIONAL)
     return Condition(text(table, "name", where), number(table, "budget", where, low=0.0),
                      integer(table, "turns", where, low=1), integer(table, "change_every", where, low=1),
-                     number(table, "seconds", where, None, above=0.0))
+                     number(table, "seconds", where, None, above=0.0),
+                     integer(table, "objects_per_scene", where, objects_per_scene, low=1))
 
 
 def _finding(table: dict, kind: str, strategies: tuple, conditions: list, where: str) -> Finding:

@@ -9,6 +9,7 @@ from dialog.cli import main
 from dialog.experiments.analysis import checkpoint_values, evaluate_findings, summarise
 from dialog.experiments.baseline import check_against_baseline, write_baseline
 from dialog.experiments.suite import SuiteError, load_suite
+from learning.errors import SettingsError
 
 SUITE = """
 name = "tiny"
@@ -169,3 +170,27 @@ def test_a_strategy_subset_says_which_findings_it_skips(tmp_path, capsys):
     assert "f1: skipped: needs active, not among the strategies run (passive)" in out
     report = (tmp_path / "out" / "report.md").read_text()
     assert "- f1: passive beats active: skipped, needs active, not among the strategies run (passive)" in report
+
+
+def test_the_pack_lunchbox_experiments_run_on_55_object_scenes(tmp_path, capsys):
+    """Issue 26 item 1: the thesis's pack-lunchbox scenes hold 55 objects (§6.5); the suites drew 12."""
+    from dialog.transcript import read_session
+    assert {c.objects_per_scene for c in load_suite("ch6-static").conditions} == {55}
+    assert {c.objects_per_scene for c in load_suite("ch7-pack-lunchbox").conditions} == {55}
+    assert {c.objects_per_scene for c in load_suite("smoke").conditions} == {None}  # the task's 12
+    out = tmp_path / "out"
+    assert main(["regress", "--suite", "ch7-pack-lunchbox", "--strategies", "passive", "--seeds", "0",
+                 "--datasets", "1", "--results", str(out), "--workers", "1", "--no-progress"]) == 0
+    (transcript,) = (out / "transcripts").rglob("*.jsonl")
+    records = read_session(transcript)[1]
+    assert {record["scene_check"]["objects"] for record in records} == {55}
+    assert "a new scene every 10 turns, 55 objects a scene" in (out / "report.md").read_text()
+
+
+def test_a_scene_size_beyond_the_task_is_refused(tmp_path):
+    from dialog.experiments.pools import PoolEnvironment, load_pools
+    pools = load_pools("pack-lunchbox", "kitchen-1", 1)
+    with pytest.raises(SettingsError, match="objects_per_scene 56 is not accepted .* 1 to 55 objects"):
+        PoolEnvironment(pools.train[0], pools.test, pools.task, 1, objects_per_scene=56)
+    suite = load_suite(write_suite(tmp_path, "objects_per_scene = 20\n" + SUITE))
+    assert {c.objects_per_scene for c in suite.conditions} == {20}

@@ -58,6 +58,7 @@ def test_the_summary_counts_questions_in_words_and_the_json_keeps_its_counts(tmp
     assert set(summary["queries"]) == {"label", "demo", "feature", "none"}
     assert f"questions: {questions_in_words(summary['queries'])};" in lines[-2]
     assert "{'" not in lines[-2]
+    assert "; 12 objects a scene (an interactive size; the thesis's experiments use 55);" in lines[-2]
 
 
 def test_default_transcript_names_say_what_differs_from_the_defaults():
