@@ -120,18 +120,30 @@ class ScriptedTeacher:
     demonstration shows an object of another concept). dont_know_rate: chance
     of answering "I don't know". feature_quality q in [0, 1]: each relevant
     feature is chosen with probability q, and about (1 - q) x as many irrelevant
-    ones are added. answer_delay: mean seconds per answer (gamma distributed),
+    ones are added. The feature answer's quality model (thesis §5.4's partial
+    and noisy teachers; all three default to the exact answer): feature_recall r
+    names round(r x |relevant|) of the relevant features (at least one, drawn
+    at random: a partial answer), feature_noise n adds round(n x |relevant|)
+    irrelevant ones (a noisy answer), feature_dont_know_rate is the chance of
+    "I don't know" to the feature question. answer_delay: mean seconds per answer (gamma distributed),
     spent on the injected clock; answer_delays: a mean per query kind instead
     (label, demo, feature), as embodied costs set them (dialog/embodied.py).
     """
 
     def __init__(self, rng: np.random.Generator, mislabel_rate: float = 0.0, dont_know_rate: float = 0.0,
                  feature_quality: float = 1.0, answer_delay: float = 0.0, clock=None,
-                 answer_delays: dict | None = None):
+                 answer_delays: dict | None = None, feature_recall: float = 1.0, feature_noise: float = 0.0,
+                 feature_dont_know_rate: float = 0.0):
         for name, value in (("mislabel rate", mislabel_rate), ("don't-know rate", dont_know_rate),
-                            ("feature quality", feature_quality)):
+                            ("feature quality", feature_quality), ("feature recall", feature_recall),
+                            ("feature noise", feature_noise), ("feature don't-know rate", feature_dont_know_rate)):
             if not 0.0 <= float(value) <= 1.0:
                 raise SettingsError(f"{name} must be between 0 and 1, got {value}")
+        self.feature_model = {"feature_recall": float(feature_recall), "feature_noise": float(feature_noise),
+                              "feature_dont_know_rate": float(feature_dont_know_rate)}
+        if self.feature_model != FEATURE_MODEL_EXACT and feature_quality != 1.0:
+            raise SettingsError("feature_quality is the older one-number model of the feature answer; give it or "
+                                "feature_recall / feature_noise / feature_dont_know_rate, not both")
         if answer_delay < 0:
             raise SettingsError(f"answer delay must be zero or more seconds, got {answer_delay}")
         self.rng = rng
@@ -143,8 +155,9 @@ class ScriptedTeacher:
         self.mislabels = 0
 
     def options(self) -> dict:
+        changed = {k: v for k, v in self.feature_model.items() if v != FEATURE_MODEL_EXACT[k]}  # recorded if set
         return {"kind": "scripted", "mislabel_rate": self.mislabel_rate, "dont_know_rate": self.dont_know_rate,
-                "feature_quality": self.feature_quality, "answer_delay": self.answer_delay}
+                "feature_quality": self.feature_quality, "answer_delay": self.answer_delay, **changed}
 
     def show(self, prompt: Prompt) -> None:
         pass
@@ -190,6 +203,9 @@ class ScriptedTeacher:
                 self.mislabels += 1
             return f"number {members[int(rng.integers(len(members)))] + 1}", delay
         if kind == "feature":
+            if self.feature_model["feature_dont_know_rate"] and rng.random() < self.feature_model[
+                    "feature_dont_know_rate"]:
+                return "I don't know", delay
             return ", ".join(prompt.feature_tree.numbers_for(self._feature_choice(prompt))), delay
         raise ValueError(f"a scripted teacher cannot answer a '{kind}' question")
 
@@ -197,11 +213,22 @@ class ScriptedTeacher:
         relevant = relevant_feature_indices(prompt)
         everything = range(len(prompt.feature_tree.feature_names))
         irrelevant = [i for i in everything if i not in set(relevant)]
+        if self.feature_model != FEATURE_MODEL_EXACT:
+            return self._modelled_feature_choice(relevant, irrelevant)
         keep = [i for i in relevant if self.rng.random() < self.feature_quality]
         if not keep:
             keep = [relevant[int(self.rng.integers(len(relevant)))]]
         extra_rate = (1.0 - self.feature_quality) * len(relevant) / max(len(irrelevant), 1)
         keep += [i for i in irrelevant if self.rng.random() < extra_rate]
+        return sorted(keep)
+
+    def _modelled_feature_choice(self, relevant: list[int], irrelevant: list[int]) -> list[int]:
+        """A partial (feature_recall) and/or noisy (feature_noise) feature answer, drawn from the teacher's rng."""
+        named = max(1, int(round(self.feature_model["feature_recall"] * len(relevant))))
+        added = min(len(irrelevant), int(round(self.feature_model["feature_noise"] * len(relevant))))
+        keep = [int(i) for i in self.rng.choice(relevant, size=named, replace=False)]
+        if added:
+            keep += [int(i) for i in self.rng.choice(irrelevant, size=added, replace=False)]
         return sorted(keep)
 
 
@@ -236,7 +263,9 @@ class ReplayTeacher:
 
 
 TEACHER_KINDS = ("terminal", "scripted", "oracle", "replay")
-SCRIPTED_OPTIONS = ("mislabel_rate", "dont_know_rate", "feature_quality", "answer_delay")
+# the feature answer's quality model (ScriptedTeacher): its defaults are the exact answer
+FEATURE_MODEL_EXACT = {"feature_recall": 1.0, "feature_noise": 0.0, "feature_dont_know_rate": 0.0}
+SCRIPTED_OPTIONS = ("mislabel_rate", "dont_know_rate", "feature_quality", "answer_delay", *FEATURE_MODEL_EXACT)
 
 
 def make_teacher(kind: str, *, rng: np.random.Generator | None = None, clock=None, transcript=None,

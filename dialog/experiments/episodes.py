@@ -61,7 +61,8 @@ class EpisodeSpec:
                                costs=dict(self.costs), seconds=condition.seconds)
 
 
-TEACHER_OPTIONS = ("kind", "mislabel_rate", "dont_know_rate", "feature_quality")
+TEACHER_OPTIONS = ("kind", "mislabel_rate", "dont_know_rate", "feature_quality", "feature_recall", "feature_noise",
+                   "feature_dont_know_rate")
 
 
 def suite_teacher(options: dict, rng: np.random.Generator, clock=None, answer_delays: dict | None = None):
@@ -70,8 +71,8 @@ def suite_teacher(options: dict, rng: np.random.Generator, clock=None, answer_de
     unknown = sorted(set(options) - set(TEACHER_OPTIONS))
     kind = options.get("kind", "scripted")
     if unknown or kind not in ("scripted", "oracle"):
-        raise SettingsError(f"teacher options {options} not supported; accepted: kind = 'scripted' or 'oracle', "
-                            f"mislabel_rate, dont_know_rate, feature_quality (each 0..1)")
+        raise SettingsError(f"teacher options {', '.join(unknown) or kind} not supported; accepted: kind = "
+                            f"'scripted' or 'oracle', {', '.join(TEACHER_OPTIONS[1:])} (each 0..1)")
     return make_teacher(kind, rng=rng, clock=clock, answer_delays=answer_delays,
                         **{k: v for k, v in options.items() if k != "kind"})
 

@@ -137,7 +137,9 @@ def markdown_report(suite: Suite, results: list[dict], summaries: list[Checkpoin
             f"embodied costs, {condition.seconds:g} s (at most {condition.turns} turns), "
         lines += [f"## Condition `{condition.name}`: budget {condition.budget:g}, "
                   f"{embodied or f'{condition.turns} turns, '}a new scene every {condition.change_every} turns, "
-                  f"{condition.scene_size(scene_default)} objects a scene", ""]
+                  f"{condition.scene_size(scene_default)} objects a scene"
+                  + (f", teacher {teacher_in_words(suite.teacher | dict(condition.teacher))}" if condition.teacher
+                     else ""), ""]
         for stem, text in (("curves", "learning curves"), ("timing", "when each strategy asked")):
             if f"{stem}-{condition.name}.png" in figure_names:
                 lines += [f"![{text}]({stem}-{condition.name}.png)", ""]

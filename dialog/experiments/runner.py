@@ -38,7 +38,8 @@ def episode_specs(suite: Suite, results_dir: Path) -> list[EpisodeSpec]:
                     specs.append(EpisodeSpec(
                         suite=suite.name, task=suite.task, kitchen=suite.kitchen, strategy=strategy,
                         condition=condition, dataset=dataset, seed=seed, costs=costs,
-                        teacher=tuple(sorted(suite.teacher.items())), transcript=str(transcript),
+                        teacher=tuple(sorted((suite.teacher | dict(condition.teacher)).items())),
+                        transcript=str(transcript),
                         plan=suite.plan_options, data_seed=suite.data_seed, weights=suite.weights.get(strategy)))
     return specs
 

@@ -23,10 +23,12 @@ SUITE_FIELDS = ("name", "description", "analysis", "kind", "task", "kitchen", "s
                 "objects_per_scene")
 CONDITION_FIELDS = ("name", "budget", "turns", "change_every")
 # seconds: embodied costs' time allocation (turns is then the cap); objects_per_scene: the scene size (thesis §6.5)
-CONDITION_OPTIONAL = ("seconds", "objects_per_scene")
+# teacher: the scripted teacher's options for this condition, over the suite's [teacher] (a sweep of them)
+CONDITION_OPTIONAL = ("seconds", "objects_per_scene", "teacher")
 FINDING_FIELDS = ("id", "text", "condition", "at", "better", "than", "alternative", "than_at", "margin")
 TEACHER_KINDS = ("scripted", "oracle")
-TEACHER_RATES = ("mislabel_rate", "dont_know_rate", "feature_quality")
+TEACHER_RATES = ("mislabel_rate", "dont_know_rate", "feature_quality", "feature_recall", "feature_noise",
+                 "feature_dont_know_rate")
 PLAN_FIELDS = ("pools", "pool_size", "test_size", "objects_per_scene")
 FEATURE_OPTIONS = ("samples", "users", "relevant_features", "user_model")
 USER_MODEL_FIELDS = ("keep_relevant", "add_irrelevant", "ignore_robot", "ignore_irrelevant_object", "ignore_relevant")
@@ -44,6 +46,7 @@ class Condition:
     change_every: int
     seconds: float | None = None  # embodied costs (thesis §8.2.2): the allocation in seconds; turns is the cap
     objects_per_scene: int | None = None  # scene size of the episodes (None: the task's interactive default)
+    teacher: tuple = ()  # ((option, value), ...): the scripted teacher's options here, over the suite's [teacher]
 
     def scene_size(self, task_default: int) -> int:
         """How many objects each scene of this condition holds."""
@@ -210,7 +213,8 @@ def _condition(table: dict, where: str, objects_per_scene: int | None = None) ->
     return Condition(text(table, "name", where), number(table, "budget", where, low=0.0),
                      integer(table, "turns", where, low=1), integer(table, "change_every", where, low=1),
                      number(table, "seconds", where, None, above=0.0),
-                     integer(table, "objects_per_scene", where, objects_per_scene, low=1))
+                     integer(table, "objects_per_scene", where, objects_per_scene, low=1),
+                     tuple(sorted(_teacher(table, where).items())))
 
 
 def _finding(table: dict, kind: str, strategies: tuple, conditions: list, where: str) -> Finding:

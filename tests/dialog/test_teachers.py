@@ -9,6 +9,7 @@ from dialog.parsing import AnswerParser
 from dialog.questions import Prompt
 from dialog.teachers import OracleTeacher, ReplayTeacher, ScriptedTeacher
 from learning.actions import DemoQuery, FeatureQuery, LabelQuery
+from learning.errors import SettingsError
 from tests.dialog.fakes import CONCEPTS, FakeEnvironment
 
 NAMES = ("colour.red", "size.length", "weight", "arm.joint1", "hand.x")
@@ -75,6 +76,44 @@ def test_feature_quality_trades_relevant_for_irrelevant_features(scene):
     extras = np.mean([len(set(c) - {0, 1}) for c in chosen])
     assert hits == pytest.approx(0.625, abs=0.08)  # at least one relevant feature is always named
     assert extras == pytest.approx(1.0, abs=0.2)
+
+
+def test_the_feature_answer_model_partial_noisy_and_dont_know(scene):
+    """Issue 26 item 3: a teacher's feature answer may name only some relevant features, add irrelevant ones,
+    or not know; the exact answer stays the default and is recorded as before (no new header keys)."""
+    relevant = ("colour.red", "size.length", "weight", "arm.joint1")
+    ask = prompt(scene, FeatureQuery(), relevant)
+
+    def read(teacher):
+        return ask.feature_tree.read(teacher.listen(ask, None)).value
+
+    half = ScriptedTeacher(np.random.default_rng(1), feature_recall=0.5)
+    picks = [set(read(half)) for _ in range(200)]
+    assert all(len(p) == 2 and p <= {0, 1, 2, 3} for p in picks) and len({frozenset(p) for p in picks}) > 3
+    noisy = ScriptedTeacher(np.random.default_rng(1), feature_noise=0.25)
+    assert all(set(read(noisy)) == {0, 1, 2, 3, 4} for _ in range(20))  # all four and round(0.25 x 4) = 1 other
+    unsure = ScriptedTeacher(np.random.default_rng(1), feature_dont_know_rate=1.0)
+    assert unsure.listen(ask, None) == "I don't know"
+    assert unsure.listen(prompt(scene, LabelQuery(0)), None) != "I don't know"  # only the feature question
+    assert "feature_recall" not in ScriptedTeacher(np.random.default_rng(0)).options()
+    assert half.options()["feature_recall"] == 0.5 and "feature_noise" not in half.options()
+    with pytest.raises(SettingsError, match="not both"):
+        ScriptedTeacher(np.random.default_rng(0), feature_quality=0.5, feature_recall=0.5)
+    with pytest.raises(SettingsError, match="feature recall must be between 0 and 1"):
+        ScriptedTeacher(np.random.default_rng(0), feature_recall=1.5)
+
+
+def test_a_suite_condition_sets_its_own_feature_answer_over_the_suite_teacher(tmp_path):
+    from dialog.experiments.runner import episode_specs
+    from dialog.experiments.suite import SuiteError, load_suite
+    suite = load_suite("ch6-static")
+    specs = {spec.condition.name: dict(spec.teacher) for spec in episode_specs(suite, tmp_path)}
+    assert specs["static"] == {} and specs["features-half"] == {"feature_recall": 0.5}
+    assert specs["features-dont-know"] == {"feature_dont_know_rate": 1.0}
+    text = open(suite.path).read().replace("feature_noise = 1.0", "feature_noise = 2.0")
+    (tmp_path / "bad.toml").write_text(text)
+    with pytest.raises(SuiteError, match="feature_noise"):
+        load_suite(tmp_path / "bad.toml")
 
 
 def test_answer_delay_is_spent_on_the_injected_clock(scene):
