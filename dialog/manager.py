@@ -117,7 +117,8 @@ class DialogManager:
         self.parser = parser or AnswerParser(environment.concepts)
         self.session = dict(session or {})
         self.state = LearningState(environment.concepts, environment.feature_names, config.budget, config.turns,
-                                   costs=config.costs, change_every=config.change_every)
+                                   costs=config.costs, change_every=config.change_every,
+                                   feature_selection=getattr(strategy, "feature_selection", None))
         self.scene = None
         self.turn = 0  # turns finished
         self.quit = False

@@ -84,7 +84,8 @@ class TeachingLoop:
 
     def _new_state(self) -> LearningState:
         return LearningState(self._names, self.feature_names, self.budget, self.turns, costs=self.costs,
-                             change_every=self.change_every)
+                             change_every=self.change_every,
+                             feature_selection=getattr(self.strategy, "feature_selection", None))
 
     # -- the world ------------------------------------------------------------------
     def observe(self, X_scene) -> None:

@@ -18,6 +18,7 @@ import numpy as np
 from learning.actions import DEFAULT_COSTS, Action, validate_costs
 from learning.answers import AnswerError, Change, DemoRow, check_answer, feature_indices
 from learning.concepts import ConceptModels, FeatureScaler, checked_rows
+from learning.features.selection import SELECTION_METHODS, computational_subsets
 from learning.progress import Progress, SceneView, read_only
 
 SOURCES = ("label", "demo")  # how a training example may have been obtained
@@ -37,9 +38,17 @@ class LearningState:
     """Everything a strategy may look at; the models are refit after every change of the training set."""
 
     def __init__(self, concepts, feature_names, budget: float, turns: int, costs: dict | None = None,
-                 change_every: int = 1, variance: float = 4.0, length_scale: float | None = None):
+                 change_every: int = 1, variance: float = 4.0, length_scale: float | None = None,
+                 feature_selection: str | None = None):
+        """``feature_selection`` (None, "FI", "ES" or "ER", thesis §5.3): the models of concepts the teacher gave
+        no feature subset for use the subset this method selects from the examples so far (one-vs-rest per
+        concept, chosen anew at every refit), as the thesis's baselines do (figs. 6.4, 6.5); None: all features."""
         if not concepts:
             raise ValueError("at least one concept is needed")
+        if feature_selection is not None and feature_selection not in SELECTION_METHODS[1:]:
+            raise ValueError(f"feature_selection must be None or one of {', '.join(SELECTION_METHODS[1:])}, got "
+                             f"{feature_selection!r}")
+        self.feature_selection = feature_selection
         if budget < 0 or turns < 1:
             raise ValueError(f"budget must be >= 0 and turns >= 1, got budget {budget}, turns {turns}")
         self.concepts = tuple(concepts)
@@ -186,9 +195,17 @@ class LearningState:
 
     def _refit(self) -> None:
         X, labels = self.training_matrix()
-        self._models.fit(self._scaler.transform(X), labels, dict(self._subsets))
+        self._models.fit(self._scaler.transform(X), labels, self._subsets_to_fit(X, labels))
         self._scene_P = None
         self._version += 1
+
+    def _subsets_to_fit(self, X: np.ndarray, labels) -> dict:
+        """The teacher's feature subsets; with ``feature_selection``, a computed one where the teacher gave none."""
+        subsets = dict(self._subsets)
+        if self.feature_selection is None or len(X) == 0 or all(s is not None for s in subsets.values()):
+            return subsets
+        chosen = computational_subsets(X, labels, self.concepts, method=self.feature_selection)
+        return {c: subsets[c] if subsets[c] is not None else chosen.get(c) for c in self.concepts}
 
     def check_action(self, action: Action) -> None:
         """A ValueError unless ``action`` is a known kind that fits this state (object in the scene, known

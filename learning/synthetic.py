@@ -77,7 +77,8 @@ def run_episode(strategy, task: SyntheticTask, rng: np.random.Generator, budget:
                 change_every: int = 5, objects: int = 12, costs: dict | None = None, test_objects: int = 200,
                 ) -> EpisodeSummary:
     """One teaching episode with the oracle; the returned accuracy is on ``test_objects`` held-out rows."""
-    state = LearningState(task.concepts, task.feature_names, budget, turns, costs=costs, change_every=change_every)
+    state = LearningState(task.concepts, task.feature_names, budget, turns, costs=costs, change_every=change_every,
+                          feature_selection=getattr(strategy, "feature_selection", None))
     test_X, test_y = task.sample(test_objects, rng)
     actions, explanations = [], []
     X: np.ndarray  # both set at turn 0, the first scene

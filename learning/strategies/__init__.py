@@ -3,8 +3,10 @@
 ``make_strategy(name)`` builds one by name; ``STRATEGY_NAMES`` lists them all.
 
 ========== ==================================================================
-passive    P: demonstrations only, the least represented concept first
-active     A: label queries by uncertainty (entropy, eq. 6.1)
+passive    P: demonstrations only, the least represented concept first (every feature)
+active     A: label queries by uncertainty (entropy, eq. 6.1) (every feature)
+passive-fs P with computational feature selection (ES), as the thesis's baseline
+active-fs  A (U-sampling) with computational feature selection (ES), as the thesis's baseline
 random     R: any affordable query at random
 hfs-passive HFS+P: the feature query first, then P
 hfs-active HFS+A: the feature query first, then A
@@ -24,12 +26,12 @@ from collections.abc import Callable
 from functools import partial
 
 from learning.errors import SettingsError, did_you_mean
-from learning.strategies.active import ActiveStrategy
+from learning.strategies.active import ActiveFeatureSelectingStrategy, ActiveStrategy
 from learning.strategies.all_cd import AllClassDistributionStrategy
 from learning.strategies.base import Strategy
 from learning.strategies.decision_theoretic import DecisionTheoreticStrategy
 from learning.strategies.hfs import HfsActiveStrategy, HfsPassiveStrategy
-from learning.strategies.passive import PassiveStrategy
+from learning.strategies.passive import PassiveFeatureSelectingStrategy, PassiveStrategy
 from learning.strategies.random_choice import RandomStrategy
 from learning.strategies.rl_questioner import PREFIX as RL_PREFIX
 from learning.strategies.rl_questioner import RLQuestionerStrategy
@@ -47,6 +49,8 @@ STRATEGIES: dict[str, Callable[..., Strategy]] = {
     "dt-task": partial(DecisionTheoreticStrategy, "dt-task"),
     "dt-task-env": partial(DecisionTheoreticStrategy, "dt-task-env"),
     "scripted-expert": ScriptedExpertStrategy,
+    "passive-fs": PassiveFeatureSelectingStrategy,
+    "active-fs": ActiveFeatureSelectingStrategy,
 }
 STRATEGY_NAMES = tuple(STRATEGIES)
 

@@ -30,3 +30,11 @@ class ActiveStrategy(Strategy):
         top = np.argsort(normalise_rows(P)[index])[::-1][:2]
         first, second = (state.concepts[i] for i in top)
         return Decision(LabelQuery(index), f"I can't tell {first} from {second} for object {index + 1}.")
+
+
+class ActiveFeatureSelectingStrategy(ActiveStrategy):
+    """The thesis's A and U-sampling (figs. 6.4, 6.5, 7.x): uncertainty sampling whose learner selects features
+    computationally (ES, as :class:`~learning.strategies.passive.PassiveFeatureSelectingStrategy`)."""
+
+    name = "active-fs"
+    feature_selection = "ES"

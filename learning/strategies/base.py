@@ -14,6 +14,9 @@ class Strategy(ABC):
     """Looks at the learning state and returns one action with a reason."""
 
     name: str = ""
+    # None: the learner's models use every feature (or the teacher's answer); "FI", "ES" or "ER": where the teacher
+    # named none, the subset that chapter 5's method selects from the examples so far (LearningState)
+    feature_selection: str | None = None
 
     @abstractmethod
     def choose(self, state: LearningState, rng: np.random.Generator) -> Decision:

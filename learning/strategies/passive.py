@@ -29,3 +29,11 @@ class PassiveStrategy(Strategy):
         if not state.can_afford(action):
             return self.out_of_budget(state)
         return Decision(action, f"I have seen the fewest examples of {concept} ({fewest}), so I ask for one.")
+
+
+class PassiveFeatureSelectingStrategy(PassiveStrategy):
+    """The thesis's P (figs. 6.4, 6.5): P whose learner selects features computationally (ES, the F_{y,c} of
+    §6.4.2 the what-if engines assume too; docs/strategies.md says why), since a baseline never asks for them."""
+
+    name = "passive-fs"
+    feature_selection = "ES"

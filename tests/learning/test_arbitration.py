@@ -20,7 +20,7 @@ TASK = SyntheticTask(n_features=10, n_informative=3, seed=1)
 
 def test_every_strategy_name_is_registered():
     assert STRATEGY_NAMES == ("passive", "active", "random", "hfs-passive", "hfs-active", "all-cd", "dt", "dt-iros",
-                              "dt-task", "dt-task-env", "scripted-expert")
+                              "dt-task", "dt-task-env", "scripted-expert", "passive-fs", "active-fs")
     for name in STRATEGY_NAMES:
         assert make_strategy(name).name == name
 

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from learning.actions import DemoQuery, LabelQuery, NoQuery, validate_costs
+from learning.actions import DemoQuery, FeatureQuery, LabelQuery, NoQuery, validate_costs
 from learning.concepts import entropy
 from learning.evaluation import accuracy
 from learning.state import LearningState
@@ -98,3 +98,30 @@ def test_undo_removes_the_last_example(rng):
     assert change.concept == "b" and [e.concept for e in state.examples] == ["a"]
     assert np.allclose(state.probabilities(), before) and state.turn == 2  # the turn stays over
     assert state.spent == 1  # the taken-back label's budget is given back
+
+
+def test_the_thesis_baselines_select_features_computationally(rng):
+    """Issue 26 item 2: P and A of figs. 6.4-6.5 'use computational feature selection'; passive/active use all."""
+    from learning.features.selection import computational_subsets
+    from learning.strategies import make_strategy as make
+    X, labels = blobs(rng)
+    noisy = np.hstack([X, rng.normal(size=(len(X), 6))])  # six features that say nothing about the concepts
+    names = ["f1", "f2", "f3", *(f"noise{i}" for i in range(6))]
+    plain = LearningState(CONCEPTS, names, budget=50, turns=50)
+    selecting = LearningState(CONCEPTS, names, budget=50, turns=50, feature_selection="ES")
+    for state in (plain, selecting):
+        state.observe_scene(0, noisy)
+        for i in range(12):
+            state.apply(LabelQuery(i), labels[i])
+    X_train, y_train = selecting.training_matrix()
+    expected = computational_subsets(X_train, y_train, CONCEPTS, method="ES")
+    fitted = selecting._models.subsets_
+    assert all(np.array_equal(fitted[c], expected[c]) for c in CONCEPTS if c in expected)
+    assert all(plain._models.subsets_[c] is None for c in CONCEPTS)
+    assert not np.allclose(plain.probabilities(), selecting.probabilities())
+    selecting.apply(FeatureQuery(), [0, 1])  # the teacher's answer, where given, wins
+    assert all(selecting._models.subsets_[c].tolist() == [0, 1] for c in CONCEPTS)
+    with pytest.raises(ValueError, match="feature_selection must be None or one of FI, ES, ER"):
+        LearningState(CONCEPTS, names, budget=5, turns=5, feature_selection="es")
+    assert make("passive-fs").feature_selection == make("active-fs").feature_selection == "ES"
+    assert make("passive").feature_selection is None and make("active").feature_selection is None
