@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import shlex
 from pathlib import Path
 
 from dialog.commands._arguments import budget, data_seed, positive_int, seeds
@@ -42,6 +43,10 @@ def register(commands) -> None:
     parser.add_argument("--data-seed", type=data_seed, default=None, metavar="N",
                         help="render (once, then cached) and use the task's data sets from seed N instead of the "
                              "suite's (default: the suite's data_seed, 0 unless it says otherwise)")
+    parser.add_argument("--data-seeds", type=data_seed, nargs="+", default=None, metavar="N",
+                        help="run the suite on the data sets of each of these data seeds (each report in "
+                             "<results>/data-seed-N/) and test its findings per data seed and pooled over all "
+                             "(<results>/replication.md)")
     parser.add_argument("--weights", type=named_weights, action="append", default=None, metavar="NAME=FILE",
                         help="add a DT strategy called NAME with the weights in FILE (as teachbot learn-weights "
                              "writes them); repeatable")
@@ -82,6 +87,8 @@ def run(args: argparse.Namespace) -> int:
                                 "--embodied-costs without --check")
     out = args.results or Path("results") / suite.name
     check_writable(out, "results", folder=True)
+    if args.data_seeds is not None:
+        return run_on_data_seeds(args, kind, suite, original, out)
     with writing(out, "results", inside=True):
         out.mkdir(parents=True, exist_ok=True)
         options = RunOptions(results=out, workers=args.workers, ray=args.ray, progress=not args.no_progress)
@@ -107,3 +114,46 @@ def run(args: argparse.Namespace) -> int:
         print(json.dumps({"suite": suite.name, "episodes": outcome.count, "seconds": round(outcome.seconds, 2),
                           **data, "passed": not failures, "failures": failures}))
     return 1 if failures else 0
+
+
+def run_on_data_seeds(args: argparse.Namespace, kind, suite, original, out: Path) -> int:
+    """--data-seeds: one run per data seed, each with its report, then the findings pooled over all of them."""
+    from dialog.experiments.data_seeds import pooled_findings, replication_report
+
+    seeds = list(dict.fromkeys(args.data_seeds))
+    if len(seeds) != len(args.data_seeds):
+        raise SettingsError(f"--data-seeds: each data seed once, got {' '.join(map(str, args.data_seeds))}")
+    for refused in ("data_seed", "check", "update_baseline"):
+        if getattr(args, refused) not in (None, False):
+            raise SettingsError(f"--data-seeds runs several data sets; --{refused.replace('_', '-')} compares or "
+                                "stores one: give one or the other")
+    if kind.name != "episodes":
+        raise SettingsError(f"--data-seeds renders the data sets of episodes suites; '{suite.name}' is a "
+                            f"{kind.name} suite")
+    runs = {}
+    for seed in seeds:
+        folder = out / f"data-seed-{seed}"
+        with writing(folder, "results", inside=True):
+            folder.mkdir(parents=True, exist_ok=True)
+            one = suite.with_overrides(data_seed=seed)
+            options = RunOptions(results=folder, workers=args.workers, ray=args.ray, progress=not args.no_progress)
+            runs[seed] = run_suite(kind, one, options, original)
+            report = kind.report(runs[seed], folder)[0]
+        print(f"{suite.name} on data seed {seed}: {runs[seed].count} runs in {runs[seed].seconds:.1f} s; "
+              f"report {report}", flush=True)
+    pooled = pooled_findings(suite, runs)
+    words = ["teachbot", "regress", "--suite", str(args.suite), "--data-seeds", *map(str, seeds)]
+    for option, values in (("--strategies", args.strategies), ("--seeds", args.seeds), ("--datasets", args.datasets)):
+        if values is not None:
+            words += [option, *map(str, values if isinstance(values, list) else [values])]
+    command = shlex.join(words)
+    with writing(out, "results", inside=True):
+        path = replication_report(suite, runs, pooled, out, command)
+    print(f"pooled over data seeds {', '.join(map(str, seeds))}: {path}")
+    for outcome in pooled:
+        print(f"  {outcome.finding.id}: {outcome.verdict}")
+    if args.json:
+        print(json.dumps({"suite": suite.name, "data_seeds": seeds, "episodes": sum(r.count for r in runs.values()),
+                          "seconds": round(sum(r.seconds for r in runs.values()), 2),
+                          "pooled": {o.finding.id: o.verdict for o in pooled}}))
+    return 0

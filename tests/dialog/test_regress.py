@@ -194,3 +194,20 @@ def test_a_scene_size_beyond_the_task_is_refused(tmp_path):
         PoolEnvironment(pools.train[0], pools.test, pools.task, 1, objects_per_scene=56)
     suite = load_suite(write_suite(tmp_path, "objects_per_scene = 20\n" + SUITE))
     assert {c.objects_per_scene for c in suite.conditions} == {20}
+
+
+def test_a_suite_on_several_data_seeds_reports_each_and_pooled(tmp_path, capsys):
+    """Issue 26 item 5: regress --data-seeds runs the suite on each rendered data set and pools the findings."""
+    suite = write_suite(tmp_path)
+    out = tmp_path / "out"
+    assert main(["regress", "--suite", str(suite), "--data-seeds", "0", "1", "--results", str(out), "--workers", "1",
+                 "--no-progress", "--json"]) == 0
+    summary = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
+    assert summary["data_seeds"] == [0, 1] and summary["episodes"] == 8 and set(summary["pooled"]) == {"f1"}
+    assert (out / "data-seed-0" / "report.md").exists() and (out / "data-seed-1" / "report.md").exists()
+    text = (out / "replication.md").read_text()
+    assert "| finding | data seed 0 | data seed 1 | pooled | pooled pairs |" in text
+    assert "teachbot regress --suite" in text and "--data-seeds 0 1" in text
+    assert main(["regress", "--suite", str(suite), "--data-seeds", "0", "0", "--results", str(out)]) == 2
+    assert "each data seed once" in capsys.readouterr().err
+    assert main(["regress", "--suite", str(suite), "--data-seeds", "0", "--check", "--results", str(out)]) == 2
