@@ -68,6 +68,9 @@ def register(commands) -> None:
     per_turn.add_argument("--policy", choices=("gated", "softmax"), default="gated",
                           help="gated (default): ask-or-not, then which query, as the DT decides; softmax: one "
                                "softmax over every candidate (docs/irl.md)")
+    parser.add_argument("--allow-degenerate", action="store_true",
+                        help="write the weights even when they can never ask (all zero but remaining_time's), which "
+                             "is otherwise refused: such a DT stays quiet every turn")
     parser.add_argument("--json", action="store_true", help="end with one JSON line: iterations, seconds, weights, "
                                                              "validation_agreement")
     parser.set_defaults(handler=run)
@@ -86,13 +89,24 @@ def run(args: argparse.Namespace, output_stream=None) -> int:
     check_options(args, method)
     check_writable(args.out, "weights file")  # before the fit, which takes a while
     learned = learn_trajectory(args, out) if method == "trajectory" else learn_per_turn(args, out)
+    unidentified = sorted(learned.result.unidentified_features)
+    if unidentified:
+        print(f"warning: the demonstrations cannot identify {', '.join(unidentified)} (equal on every candidate of "
+              "every demonstrated turn): left at 0", file=sys.stderr, flush=True)
+    fitted = UserWeights(str(args.out), tuple(learned.weights.as_dict().items()))
+    if fitted.never_asks() and not getattr(args, "allow_degenerate", False):
+        raise SettingsError(f"--out {args.out}: nothing written: the fit kept iteration "
+                            f"{learned.result.best_iteration}, whose weights can never ask (every weight but "
+                            "remaining_time's is 0, so every turn ties with no query); fit with other options "
+                            "(e.g. --method trajectory, more "
+                            "--iterations), or write them anyway with --allow-degenerate")
     with writing(args.out, "weights file"):
         save_weights(args.out, learned.weights, weights_comment(learned))
     for name, value in learned.weights.as_dict().items():
         note = "  (unidentified: equal on every candidate)" if name in learned.result.unidentified_features else ""
         print(f"  {name:<30} {value:>12.4f}{note}", file=out)
     print(f"wrote {args.out}", file=out)
-    UserWeights(str(args.out), tuple(learned.weights.as_dict().items())).warn_if_never_asks()
+    fitted.warn_if_never_asks()
     if args.json:
         print(json.dumps(learned.summary()), file=out, flush=True)
     return 0

@@ -17,8 +17,15 @@ LEARNED = WEIGHTS_DIRECTORY / "dt-task-env.toml"  # the dt-task-env preset carri
 def test_learn_weights_per_turn_on_the_shipped_demos_prints_the_summary(tmp_path, capsys):
     """The per-turn fit (--method per-turn); it reproduces the shipped file when that was learned per turn."""
     out = tmp_path / "w.toml"
-    assert main(["learn-weights", "--demos", "shipped", "--out", str(out), "--method", "per-turn", "--json"]) == 0
-    summary = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
+    assert main(["learn-weights", "--demos", "shipped", "--out", str(out), "--method", "per-turn", "--json"]) == 2
+    error = capsys.readouterr().err  # issue 23 case 2 / issue 27 item 2: a fit that can never ask is refused
+    assert "nothing written" in error and "can never ask" in error and "--allow-degenerate" in error
+    assert "cannot identify remaining_time" in error and not out.exists()
+    assert main(["learn-weights", "--demos", "shipped", "--out", str(out), "--method", "per-turn", "--json",
+                 "--allow-degenerate"]) == 0
+    captured = capsys.readouterr()
+    assert sum("never asks" in line for line in captured.err.splitlines()) == 1  # written, and warned about
+    summary = json.loads(captured.out.strip().splitlines()[-1])
     assert set(summary) == {"iterations", "seconds", "weights", "validation_agreement"}
     assert 0.0 <= summary["validation_agreement"] <= 1.0 and 1 <= summary["iterations"] <= 100
     assert list(summary["weights"]) == list(FEATURE_NAMES)
