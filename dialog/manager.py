@@ -392,7 +392,7 @@ class DialogManager:
         return turn
 
     def model_summary(self) -> dict:
-        subsets = [s for s in self.state.feature_subsets.values() if s is not None]
+        subsets = [s for s in self.state.fitted_feature_subsets.values() if s is not None]
         in_use = len(subsets[0]) if subsets else len(self.state.feature_names)
         return {"examples": self.state.counts_per_concept(), "features_in_use": in_use}
 

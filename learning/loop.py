@@ -173,7 +173,8 @@ class TeachingLoop:
         state = self.state_or_error()
         X, labels = state.training_matrix()
         codes = np.array([self._names.index(label) for label in labels], dtype=int)
-        subsets = {self.concepts[self._names.index(c)]: s for c, s in state.feature_subsets.items() if s is not None}
+        subsets = {self.concepts[self._names.index(c)]: s for c, s in state.fitted_feature_subsets.items()
+                   if s is not None}
         classifier = ConceptClassifier(length_scale=state.length_scale, variance=state.kernel_variance)
         classifier.n_features_in_ = len(state.feature_names)
         classifier._install(_label_array(self.concepts), state.scaler, X, codes, subsets)

@@ -272,8 +272,14 @@ class LearningState:
 
     @property
     def feature_subsets(self) -> MappingProxyType:
-        """Each concept's feature indices (read-only), None for every feature."""
+        """Each concept's feature indices as the teacher gave them (read-only), None for every feature."""
         return self._subsets
+
+    @property
+    def fitted_feature_subsets(self) -> MappingProxyType:
+        """The feature indices each concept's model uses: the teacher's, or with ``feature_selection`` the
+        computed ones where the teacher gave none (None: every feature)."""
+        return MappingProxyType({c: self._models.subsets_.get(c) for c in self.concepts})
 
     @property
     def scaler(self) -> FeatureScaler:
