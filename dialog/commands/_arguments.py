@@ -121,7 +121,7 @@ def kitchen_name(text: str) -> str:
     if name.endswith(".toml") or name in kitchen_names():
         return name
     numbers = ", ".join(name.removeprefix("kitchen-") for name in kitchen_names())
-    raise argparse.ArgumentTypeError(f"no kitchen '{text}'{did_you_mean(name, kitchen_names())}; accepted: "
+    raise argparse.ArgumentTypeError(f"no kitchen '{text}'{did_you_mean(text, kitchen_names())}; accepted: "
                                      f"{', '.join(kitchen_names())} (or just the "
                                      f"number: {numbers}; or a kitchen .toml file)")
 

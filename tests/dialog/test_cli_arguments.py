@@ -80,7 +80,7 @@ def test_unknown_names_are_refused_with_the_accepted_ones(capsys):
     kitchen = _refusal(capsys, "demo", "--kitchen", "9")
     assert kitchen.startswith("teachbot demo: --kitchen: no kitchen '9'; accepted: kitchen-1, kitchen-2, kitchen-3")
     task = _refusal(capsys, "view", "--task", "pack-lunch")
-    assert task.startswith("teachbot view: --task: no task 'pack-lunch'; accepted: ")
+    assert task.startswith("teachbot view: --task: no task 'pack-lunch' (did you mean 'pack-lunchbox'?); accepted: ")
     assert all(name in task for name in available("tasks"))
     strategy = _refusal(capsys, "demo", "--strategy", "clever")
     assert strategy.startswith("teachbot demo: --strategy: 'clever' is not one of the accepted names: ")
