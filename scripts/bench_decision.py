@@ -40,6 +40,8 @@ def _parse(argv):
     parser.add_argument("--repeats", type=int, default=5, help="cold runs per fast timing, best kept (default 5)")
     parser.add_argument("--threads", type=int, default=1, help="BLAS threads (default 1)")
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--profile", type=int, default=0, metavar="N",
+                        help="also print cProfile's top N entries (cumulative) of the fast decisions, per size")
     parser.add_argument("--json", action="store_true", help="end with one JSON line (a list, one object per size)")
     args = parser.parse_args(argv)
     for name in ("states", "reference_states_large", "repeats", "threads"):
@@ -72,15 +74,30 @@ def decide(state, engine: str, weights: np.ndarray):
     return candidates, utilities, choose_index(utilities)
 
 
+def print_profile(states, weights: np.ndarray, top: int) -> None:
+    """cProfile of one cold fast decision per state, the ``top`` entries by cumulative time."""
+    import cProfile
+    import pstats
+
+    profiler = cProfile.Profile()
+    for state in states:
+        state.cache.clear()
+        profiler.enable()
+        decide(state, "fast", weights)
+        profiler.disable()
+    pstats.Stats(profiler, stream=sys.stdout).sort_stats("cumulative").print_stats(top)
+
+
 def measure_size(n_objects: int, n_train: int, args, weights: np.ndarray) -> dict:
     task = SyntheticTask(seed=args.seed)
     rng = np.random.default_rng([args.seed, n_objects, n_train])
     with_reference = args.states if n_train < LARGE_TRAINING_SET else min(args.states, args.reference_states_large)
     fast_ms, fast_cpu_ms, reference_ms, reference_cpu_ms = [], [], [], []
-    same, regrets, eu_errors, open_fsq = [], [], [], 0
+    same, regrets, eu_errors, open_fsq, states_seen = [], [], [], 0, []
     for index in range(args.states):
         state = random_state(task, n_train, n_objects, rng, feature_query_answered=bool(rng.random() < 0.5))
         state.probabilities()  # the learner's current beliefs belong to the state, not to the decision
+        states_seen.append(state)
         open_fsq += not state.feature_query_asked
         best, best_cpu = np.inf, np.inf
         for _ in range(args.repeats):
@@ -101,6 +118,8 @@ def measure_size(n_objects: int, n_train: int, args, weights: np.ndarray) -> dic
         same.append(fast_choice == reference_choice)
         regrets.append(float(reference_utilities[reference_choice] - reference_utilities[fast_choice]))
         eu_errors.append(float(np.max(np.abs(fast_utilities - reference_utilities))))
+    if args.profile:
+        print_profile(states_seen, weights, args.profile)
     fast_p50, reference_p50 = np.percentile(fast_ms, 50), np.percentile(reference_ms, 50)
     return {
         "scene_objects": n_objects, "n_train": n_train,
