@@ -27,7 +27,8 @@ skactiveml-us and modal-entropy (entropy sampling, a label every turn the budget
 and skactiveml-eer (expected-utility or expected-error choices among labels; DT may also stay quiet).
 teachbot-dt is not comparable in accuracy: it also buys demonstrations (cost 2) and asks a feature query.
 
-Timing: one decision is ``TeachingLoop.ask()`` or ``query()``; refitting after an answer is outside it
+Timing: CPU time of this process (the machine is shared; other programs do not inflate it); one decision
+is ``TeachingLoop.ask()`` or ``query()``; refitting after an answer is outside it
 (``tell`` for teachbot; for UncertaintySampling the classifier is fitted after each label and ``query``
 gets ``fit_clf=False``). MonteCarloEER must fit inside ``query`` (it refits per candidate and answer on
 the labelled rows it is given), so its time holds one extra fit on those few labels.
@@ -105,10 +106,10 @@ def run_teachbot(method: str, X, y, scenes, X_test, y_test, args, seed: int) -> 
             index = scenes[turn // args.change_every]
             loop.observe(X[index])
         can_ask = loop.budget_left >= min(loop.costs[k] for k in ("label", "demo", "feature"))
-        start = time.perf_counter()
+        start = time.process_time()
         query = loop.ask()
         if can_ask:  # turns with the budget spent are no decisions (the peers time none either)
-            times.append(time.perf_counter() - start)
+            times.append(time.process_time() - start)
         truth = y[index]
         if query.kind == "label":
             loop.tell(truth[query.object])
@@ -160,10 +161,10 @@ def run_peer(method: str, X, y, scenes, X_test, y_test, args, seed: int) -> dict
             continue
         X_all = np.vstack([labelled_X, Xs[index]])
         y_all = np.concatenate([labelled_y, np.full(len(index), -1)])
-        start = time.perf_counter()
+        start = time.process_time()
         chosen = chooser.query(X_all, y_all, clf, fit_clf=method == "skactiveml-eer",
                                candidates=np.array(candidates) + len(labelled_X))
-        times.append(time.perf_counter() - start)
+        times.append(time.process_time() - start)
         pick = int(chosen[0]) - len(labelled_X)
         asked.add(pick)
         budget -= 1
@@ -218,9 +219,9 @@ def run_modal(method: str, X, y, scenes, X_test, y_test, args, seed: int) -> dic
         candidates = [i for i in range(len(index)) if i not in asked]
         if budget < 1 or not candidates:
             continue
-        start = time.perf_counter()
+        start = time.process_time()
         chosen, _ = learner.query(Xs[index[candidates]])
-        times.append(time.perf_counter() - start)
+        times.append(time.process_time() - start)
         pick = candidates[int(np.ravel(chosen)[0])]
         asked.add(pick)
         budget -= 1
