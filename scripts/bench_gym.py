@@ -16,7 +16,7 @@
 
 BLAS runs on one thread. Speeds are CPU time of this process (other programs on the shared machine do not
 inflate it), each measured ``--pairs`` times back to back in rotating order; the ratios env / loop are taken
-within each repetition and their median reported, with their range. Decision times are wall-clock medians;
+within each repetition and their median reported, with their range. Decision times are CPU-time medians too;
 the load average is reported.
 
     python scripts/bench_gym.py --json        # last line: one JSON object
@@ -148,9 +148,9 @@ def decision_times(policy_path: Path, episodes: int, seed: int) -> dict:
             state.probabilities()  # p(y|x) of the scene is part of the state (as in bench_decision.py)
             for name, strategy in (("rl", rl), ("dt-task", dt)):
                 state.cache.clear()  # each starts cold: no what-if result memoised by the other
-                started = time.perf_counter()
+                started = time.process_time()
                 strategy.choose(state, rng)
-                times[name].append(time.perf_counter() - started)
+                times[name].append(time.process_time() - started)
             _, _, done, _, info = env.step(int(rng.choice(np.flatnonzero(info["action_mask"]))))
     rl_ms, dt_ms = (1000 * float(np.median(times[k])) for k in ("rl", "dt-task"))
     return {"policy": source, "decisions": len(times["rl"]), "rl_ms": round(rl_ms, 3), "dt_task_ms": round(dt_ms, 3),
