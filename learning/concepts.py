@@ -108,13 +108,14 @@ class ConceptModels:
             if subset is not None and len(subset):  # None or empty: all features
                 checked_subset(subset, X.shape[1], f"feature subset of '{concept}'")
         previous = getattr(self, "subsets_", None)
+        fitted = getattr(self, "models_", {})  # an answer that only adds rows updates these (BinaryGPClassifier.fit)
         self.subsets_ = {c: subsets.get(c) for c in self.concepts}
         models = {}
         try:
             for concept in self.concepts:
                 columns = self.columns(concept, X.shape[1])
-                models[concept] = BinaryGPClassifier(self.length_scale, self.variance).fit(X[:, columns],
-                                                                                          labels == concept)
+                models[concept] = BinaryGPClassifier(self.length_scale, self.variance).fit(
+                    X[:, columns], labels == concept, previous=fitted.get(concept))
         except Exception:
             if previous is None:
                 del self.subsets_

@@ -11,8 +11,11 @@ on standardised features makes every refit cheap and deterministic.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
-from scipy.linalg import cho_factor, cho_solve
+from scipy.linalg import cho_factor, cho_solve, cholesky, solve_triangular
+from scipy.linalg.lapack import dpotrf
 
 
 def rbf_kernel(A: np.ndarray, B: np.ndarray, length_scale: float, variance: float) -> np.ndarray:
@@ -26,18 +29,30 @@ def default_length_scale(n_features: int) -> float:
     return float(np.sqrt(max(n_features, 1)))
 
 
+# Below this many examples a fresh fit is cheaper than an update (Python overhead; scripts/bench_refit.py).
+INCREMENTAL_FROM = 100
+
+
 class BinaryGPClassifier:
     """p(y = 1 | x) for one concept; sensible with no or one-class data (falls back to the prior)."""
 
+    K_: np.ndarray  # the training kernel, kept so that an answer's refit only computes the new rows
+
     def __init__(self, length_scale: float | None = None, variance: float = 4.0, max_newton_steps: int = 30,
-                 tolerance: float = 1e-6):
+                 tolerance: float = 1e-6, incremental_from: int = INCREMENTAL_FROM):
         self.length_scale = length_scale
         self.variance = variance
         self.max_newton_steps = max_newton_steps
         self.tolerance = tolerance
+        self.incremental_from = incremental_from
 
-    def fit(self, X: np.ndarray, y: np.ndarray) -> BinaryGPClassifier:
-        """Fit on rows ``X`` with labels ``y`` in {0, 1} (or booleans)."""
+    def fit(self, X: np.ndarray, y: np.ndarray, previous: BinaryGPClassifier | None = None) -> BinaryGPClassifier:
+        """Fit on rows ``X`` with labels ``y`` in {0, 1} (or booleans).
+
+        ``previous``: an earlier fit of this kind. When ``X`` and ``y`` only append rows to its training set
+        (same kernel, same rows before them), the fit is updated instead of redone (``_extend``): its kernel
+        is reused and Newton starts at its mode. The result equals a fresh fit within the Newton tolerance.
+        """
         X = np.asarray(X, dtype=float)
         y = np.asarray(y).astype(float).ravel()
         if X.ndim != 2 or len(X) != len(y):
@@ -45,18 +60,71 @@ class BinaryGPClassifier:
         self.X_train_ = X
         self.length_scale_ = self.length_scale or default_length_scale(X.shape[1])
         self.targets_ = 2.0 * y - 1.0  # {-1, +1}
+        self.incremental_ = False
         if len(y) == 0:
             self.f_hat_ = np.zeros(0)
             return self
-        K = rbf_kernel(X, X, self.length_scale_, self.variance)
-        self.f_hat_, self.W_sqrt_, self.L_ = self._newton(K, self.targets_)
+        if previous is not None and self._extends(previous):
+            self.K_ = extended_kernel(previous.K_, previous.X_train_, X[len(previous.targets_):],
+                                      self.length_scale_, self.variance)
+            self.f_hat_, self.W_sqrt_, self.L_ = self._extend(previous, self.K_, self.targets_)
+            self.incremental_ = True
+        else:
+            self.K_ = rbf_kernel(X, X, self.length_scale_, self.variance)
+            self.f_hat_, self.W_sqrt_, self.L_ = self._newton(self.K_, self.targets_)
         self.grad_ = (self.targets_ + 1) / 2 - sigmoid(self.f_hat_)  # d log p(y|f) / df at the mode
         return self
 
-    def _newton(self, K: np.ndarray, t: np.ndarray):
-        """Mode of p(f | X, y) by Newton's method (R&W algorithm 3.1)."""
+    def _extends(self, previous: BinaryGPClassifier) -> bool:
+        """Whether this fit's training set is ``previous``'s with rows appended, under the same kernel."""
+        n_old = len(getattr(previous, "targets_", ()))
+        return (max(1, self.incremental_from) <= n_old < len(self.targets_)
+                and getattr(previous, "K_", None) is not None and previous.X_train_.shape[1] == self.X_train_.shape[1]
+                and previous.length_scale_ == self.length_scale_ and previous.variance == self.variance
+                and np.array_equal(previous.targets_, self.targets_[:n_old])
+                and np.array_equal(previous.X_train_, self.X_train_[:n_old]))
+
+    def _extend(self, previous: BinaryGPClassifier, K: np.ndarray, t: np.ndarray):
+        """The mode after appending sites to ``previous``'s fit, in O(n^2) per step, then its exact factor.
+
+        Start: the old sites at the old mode (a = its gradient) and each new site at its predictive mean
+        given them (f = K a). Chord Newton steps a <- a + (I + W0 K)^-1 (grad - a) solve with the old
+        factor bordered by the new rows (exact for B0 = I + S0 K S0, S0 the old W^1/2 and the new sites'
+        at the start): two triangular solves and two products with K per step. The fixed point is the
+        mode itself; only the rate depends on how far W moved from W0. If the steps stop shrinking, Newton
+        with a fresh factor per step takes over (``_newton`` from the current point). The predictive
+        variance needs B at the mode, so its factor is computed once at the end.
+        """
+        n_old = len(previous.targets_)
+        a = np.concatenate([previous.grad_, np.zeros(len(t) - n_old)])
+        f = K @ a
+        pi = sigmoid(f[n_old:])
+        sw0 = np.concatenate([previous.W_sqrt_, np.sqrt(pi * (1 - pi))])
+        factor = BorderedFactor.of(previous.L_[0], K, sw0)
+        last = np.inf
+        for _ in range(self.max_newton_steps):
+            r = (t + 1) / 2 - sigmoid(f) - a
+            Kr = K @ r
+            solved = sw0 * factor.solve(sw0 * Kr)
+            step_f = Kr - K @ solved
+            a += r - solved
+            f += step_f
+            size = float(np.max(np.abs(step_f)))
+            if size < CHORD_TOLERANCE * self.tolerance:
+                break
+            if size > CHORD_CONTRACTION * last:  # W moved too far for the old factor: refactor every step
+                return self._newton(K, t, start=f)
+            last = size
+        else:
+            return self._newton(K, t, start=f)
+        pi = sigmoid(f)
+        sw = np.sqrt(pi * (1 - pi))
+        return f, sw, mode_factor(K, sw)
+
+    def _newton(self, K: np.ndarray, t: np.ndarray, start: np.ndarray | None = None):
+        """Mode of p(f | X, y) by Newton's method (R&W algorithm 3.1), from f = 0 unless ``start`` is given."""
         n = len(t)
-        f = np.zeros(n)
+        f = np.zeros(n) if start is None else start
         for _ in range(self.max_newton_steps):
             pi = sigmoid(f)
             W = pi * (1 - pi)
@@ -91,6 +159,68 @@ class BinaryGPClassifier:
         """p(y = 1 | x) by the probit approximation sigma(mu / sqrt(1 + pi var / 8))."""
         mean, var = self.latent(X)
         return sigmoid(mean / np.sqrt(1.0 + np.pi * var / 8.0))
+
+
+# The chord steps of an incremental refit stop once the latent values move by less than this fraction of the
+# Newton tolerance (a fresh fit's last step is below the tolerance itself; its error is far below it), and
+# give way to full Newton if a step is not at least this much smaller than the one before.
+CHORD_TOLERANCE = 1e-3
+CHORD_CONTRACTION = 0.5
+
+
+def extended_kernel(K: np.ndarray, X_old: np.ndarray, X_new: np.ndarray, length_scale: float,
+                    variance: float) -> np.ndarray:
+    """K over the old rows then ``X_new``, reusing the old block: O(n k d) new entries instead of O(n^2 d)."""
+    n_old, n = len(X_old), len(X_old) + len(X_new)
+    extended = np.empty((n, n))
+    extended[:n_old, :n_old] = K
+    across = rbf_kernel(X_old, X_new, length_scale, variance)
+    extended[:n_old, n_old:] = across
+    extended[n_old:, :n_old] = across.T
+    extended[n_old:, n_old:] = rbf_kernel(X_new, X_new, length_scale, variance)
+    return extended
+
+
+@dataclass(frozen=True)
+class BorderedFactor:
+    """The lower Cholesky factor of I + S K S (S = diag(sw)) from ``L_old``, the factor of its leading block.
+
+    The new rows: L21 = (L_old^-1 S1 K12 S2)^T and L22 = chol(I + S2 K22 S2 - L21 L21^T), O(n^2 k) for k
+    new rows; ``L_old`` is used in place (no copy of the n x n factor), solves go block by block.
+    """
+
+    old: np.ndarray  # L_old, lower (only its lower triangle is read)
+    border: np.ndarray  # L21^T, (n_old, k)
+    corner: np.ndarray  # L22, lower (k, k)
+
+    @classmethod
+    def of(cls, L_old: np.ndarray, K: np.ndarray, sw: np.ndarray) -> BorderedFactor:
+        n_old = len(L_old)
+        s_old, s_new = sw[:n_old], sw[n_old:]
+        border = solve_triangular(L_old, s_old[:, None] * K[:n_old, n_old:] * s_new[None, :], lower=True,
+                                  check_finite=False)
+        corner = np.eye(len(s_new)) + s_new[:, None] * K[n_old:, n_old:] * s_new[None, :] - border.T @ border
+        return cls(L_old, border, cholesky(corner, lower=True, check_finite=False))
+
+    def solve(self, b: np.ndarray) -> np.ndarray:
+        """(L L^T)^-1 b, forward then back substitution by blocks."""
+        n_old = len(self.old)
+        top = solve_triangular(self.old, b[:n_old], lower=True, check_finite=False)
+        bottom = solve_triangular(self.corner, b[n_old:] - self.border.T @ top, lower=True, check_finite=False)
+        bottom = solve_triangular(self.corner, bottom, lower=True, trans="T", check_finite=False)
+        top = solve_triangular(self.old, top - self.border @ bottom, lower=True, trans="T", check_finite=False)
+        return np.concatenate([top, bottom])
+
+
+def mode_factor(K: np.ndarray, sw: np.ndarray) -> tuple[np.ndarray, bool]:
+    """``cho_factor(I + S K S, lower=True)`` built in place, one n x n array (S = diag(sw))."""
+    B = sw[:, None] * K
+    B *= sw[None, :]
+    B.flat[:: len(sw) + 1] += 1.0
+    factor, info = dpotrf(B.T, lower=1, clean=0, overwrite_a=1)  # B.T: the same symmetric matrix, Fortran order
+    if info != 0:
+        raise np.linalg.LinAlgError(f"I + S K S is not positive definite (LAPACK dpotrf info {info})")
+    return factor, True
 
 
 def sigmoid(z: np.ndarray) -> np.ndarray:

@@ -13,9 +13,10 @@ argmax); the learner's current p(y|x) is part of the state and computed
 before the clock starts. Each fast timing is the best of ``--repeats`` cold
 runs (the state's cache cleared before each); the reference is timed once.
 BLAS runs on one thread unless ``--threads`` says otherwise. ``fast_ms`` and
-``reference_ms`` are wall-clock; ``fast_cpu_ms`` is this process's CPU time
-for the same runs, which other programs on a busy machine do not inflate; the
-load average at the start and end is printed and reported.
+``reference_ms`` are wall-clock; ``fast_cpu_ms`` and ``reference_cpu_ms`` are
+this process's CPU time for the same runs, which other programs on a busy
+machine do not inflate (``speedup_cpu`` compares those); the load average at
+the start and end is printed and reported.
 
     python scripts/bench_decision.py --json        # last line: one JSON object per size
 """
@@ -39,6 +40,8 @@ def _parse(argv):
     parser.add_argument("--repeats", type=int, default=5, help="cold runs per fast timing, best kept (default 5)")
     parser.add_argument("--threads", type=int, default=1, help="BLAS threads (default 1)")
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--profile", type=int, default=0, metavar="N",
+                        help="also print cProfile's top N entries (cumulative) of the fast decisions, per size")
     parser.add_argument("--json", action="store_true", help="end with one JSON line (a list, one object per size)")
     args = parser.parse_args(argv)
     for name in ("states", "reference_states_large", "repeats", "threads"):
@@ -71,14 +74,30 @@ def decide(state, engine: str, weights: np.ndarray):
     return candidates, utilities, choose_index(utilities)
 
 
+def print_profile(states, weights: np.ndarray, top: int) -> None:
+    """cProfile of one cold fast decision per state, the ``top`` entries by cumulative time."""
+    import cProfile
+    import pstats
+
+    profiler = cProfile.Profile()
+    for state in states:
+        state.cache.clear()
+        profiler.enable()
+        decide(state, "fast", weights)
+        profiler.disable()
+    pstats.Stats(profiler, stream=sys.stdout).sort_stats("cumulative").print_stats(top)
+
+
 def measure_size(n_objects: int, n_train: int, args, weights: np.ndarray) -> dict:
     task = SyntheticTask(seed=args.seed)
     rng = np.random.default_rng([args.seed, n_objects, n_train])
     with_reference = args.states if n_train < LARGE_TRAINING_SET else min(args.states, args.reference_states_large)
-    fast_ms, fast_cpu_ms, reference_ms, same, regrets, eu_errors, open_fsq = [], [], [], [], [], [], 0
+    fast_ms, fast_cpu_ms, reference_ms, reference_cpu_ms = [], [], [], []
+    same, regrets, eu_errors, open_fsq, states_seen = [], [], [], 0, []
     for index in range(args.states):
         state = random_state(task, n_train, n_objects, rng, feature_query_answered=bool(rng.random() < 0.5))
         state.probabilities()  # the learner's current beliefs belong to the state, not to the decision
+        states_seen.append(state)
         open_fsq += not state.feature_query_asked
         best, best_cpu = np.inf, np.inf
         for _ in range(args.repeats):
@@ -91,13 +110,16 @@ def measure_size(n_objects: int, n_train: int, args, weights: np.ndarray) -> dic
         fast_cpu_ms.append(1e3 * best_cpu)
         if index >= with_reference:
             continue
-        started = time.perf_counter()
+        started, started_cpu = time.perf_counter(), time.process_time()
         reference, reference_utilities, reference_choice = decide(state, "reference", weights)
         reference_ms.append(1e3 * (time.perf_counter() - started))
+        reference_cpu_ms.append(1e3 * (time.process_time() - started_cpu))
         assert reference.actions == candidates.actions
         same.append(fast_choice == reference_choice)
         regrets.append(float(reference_utilities[reference_choice] - reference_utilities[fast_choice]))
         eu_errors.append(float(np.max(np.abs(fast_utilities - reference_utilities))))
+    if args.profile:
+        print_profile(states_seen, weights, args.profile)
     fast_p50, reference_p50 = np.percentile(fast_ms, 50), np.percentile(reference_ms, 50)
     return {
         "scene_objects": n_objects, "n_train": n_train,
@@ -106,7 +128,10 @@ def measure_size(n_objects: int, n_train: int, args, weights: np.ndarray) -> dic
                         "p95": round(float(np.percentile(fast_cpu_ms, 95)), 2)},
         "reference_ms": {"p50": round(float(reference_p50), 1),
                          "p95": round(float(np.percentile(reference_ms, 95)), 1)},
+        "reference_cpu_ms": {"p50": round(float(np.percentile(reference_cpu_ms, 50)), 1),
+                             "p95": round(float(np.percentile(reference_cpu_ms, 95)), 1)},
         "speedup": round(float(reference_p50 / fast_p50), 1),
+        "speedup_cpu": round(float(np.percentile(reference_cpu_ms, 50) / np.percentile(fast_cpu_ms, 50)), 1),
         "same_action": round(float(np.mean(same)), 4),
         "max_regret": float(f"{max(regrets):.3g}"),
         "max_eu_error": float(f"{max(eu_errors):.3g}"),
@@ -121,7 +146,7 @@ def main(args) -> int:
     print(f"DT decision, weights {args.weights}, |Y| = 4, |F| = 90, BLAS threads {args.threads}, "
           f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} CPUs")
     print(f"{'|X|':>4} {'n':>4} | {'fast p50':>9} {'p95':>7} | {'cpu p50':>8} {'p95':>7} | {'ref p50':>9} {'p95':>9} | "
-          f"{'speedup':>8} | {'same':>5} {'max regret':>10} {'max EU err':>10} | states (ref) | load")
+          f"{'speedup':>8} {'cpu':>6} | {'same':>5} {'max regret':>10} {'max EU err':>10} | states (ref) | load")
     for n_train in args.train:
         for n_objects in args.objects:
             row = measure_size(n_objects, n_train, args, weights)
@@ -129,7 +154,8 @@ def main(args) -> int:
             print(f"{n_objects:>4} {n_train:>4} | {row['fast_ms']['p50']:>7.2f}ms {row['fast_ms']['p95']:>5.1f}ms | "
                   f"{row['fast_cpu_ms']['p50']:>6.2f}ms {row['fast_cpu_ms']['p95']:>5.1f}ms | "
                   f"{row['reference_ms']['p50']:>7.0f}ms {row['reference_ms']['p95']:>7.0f}ms | "
-                  f"{row['speedup']:>7.0f}x | {row['same_action']:>5.2f} {row['max_regret']:>10.2g} "
+                  f"{row['speedup']:>7.0f}x {row['speedup_cpu']:>5.0f}x | {row['same_action']:>5.2f} "
+                  f"{row['max_regret']:>10.2g} "
                   f"{row['max_eu_error']:>10.2g} | {row['states']} ({row['reference_states']}) | "
                   f"{row['load_average']:.1f}", flush=True)
     if args.json:

@@ -14,7 +14,10 @@
    p(y|x) is computed before the clock starts and the what-if cache is
    cleared before each.
 
-BLAS runs on one thread. Wall-clock medians; the load average is reported.
+BLAS runs on one thread. Speeds are CPU time of this process (other programs on the shared machine do not
+inflate it), each measured ``--pairs`` times back to back in rotating order; the ratios env / loop are taken
+within each repetition and their median reported, with their range. Decision times are CPU-time medians too;
+the load average is reported.
 
     python scripts/bench_gym.py --json        # last line: one JSON object
 """
@@ -37,12 +40,37 @@ def _parse(argv):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--episodes", type=int, default=6, help="episodes per measurement (default 6)")
     parser.add_argument("--policy", type=Path, default=SHIPPED, help="questioner policy (default: the shipped one)")
+    parser.add_argument("--pairs", type=int, default=5,
+                        help="repeated (loop, environment) measurements; the ratios are their medians (default 5)")
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--json", action="store_true", help="end with one JSON line")
     args = parser.parse_args(argv)
-    if args.episodes < 1:
-        parser.error(f"--episodes must be at least 1, got {args.episodes}")
+    for name in ("episodes", "pairs"):
+        if getattr(args, name) < 1:
+            parser.error(f"--{name} must be at least 1, got {getattr(args, name)}")
     return args
+
+
+def repeated_pairs(pairs: int, episodes: int, seed: int) -> dict:
+    """Loop turns/s and environment steps/s (with and without the what-if observation), measured ``pairs`` times
+    back to back, the order rotating each time; the ratios env / loop are taken within each repetition, and
+    the medians over repetitions are reported (one repetition's ratio swings with what else the machine runs)."""
+    measures = {"loop": lambda: loop_turns_per_second(episodes, seed),
+                "whatif": lambda: env_steps_per_second(True, episodes, seed),
+                "no_whatif": lambda: env_steps_per_second(False, episodes, seed)}
+    names = list(measures)
+    rates: dict[str, list[float]] = {name: [] for name in names}
+    for repetition in range(pairs):
+        for name in names[repetition % 3:] + names[: repetition % 3]:
+            rates[name].append(measures[name]())
+    whatif_ratios = [w / loop for w, loop in zip(rates["whatif"], rates["loop"])]
+    no_whatif_ratios = [w / loop for w, loop in zip(rates["no_whatif"], rates["loop"])]
+    return {"pairs": pairs, "loop_turns_per_s": round(float(np.median(rates["loop"])), 2),
+            "env_steps_per_s_whatif": round(float(np.median(rates["whatif"])), 2),
+            "env_steps_per_s_no_whatif": round(float(np.median(rates["no_whatif"])), 2),
+            "env_whatif_over_loop": round(float(np.median(whatif_ratios)), 3),
+            "env_no_whatif_over_loop": round(float(np.median(no_whatif_ratios)), 3),
+            "env_whatif_over_loop_range": [round(min(whatif_ratios), 3), round(max(whatif_ratios), 3)]}
 
 
 def env_steps_per_second(whatif: bool, episodes: int, seed: int) -> float:
@@ -63,9 +91,9 @@ def env_steps_per_second(whatif: bool, episodes: int, seed: int) -> float:
         return steps
 
     play(seed + episodes)  # a warm-up episode, not timed (imports, caches)
-    started = time.perf_counter()
+    started = time.process_time()
     steps = sum(play(episode) for episode in range(seed, seed + episodes))
-    return steps / (time.perf_counter() - started)
+    return steps / (time.process_time() - started)
 
 
 def loop_turns_per_second(episodes: int, seed: int) -> float:
@@ -84,9 +112,9 @@ def loop_turns_per_second(episodes: int, seed: int) -> float:
             return len(run_episode(spec)["series"]["turn"])
 
         play(seed + episodes)  # a warm-up episode, not timed
-        started = time.perf_counter()
+        started = time.process_time()
         turns = sum(play(episode) for episode in range(seed, seed + episodes))
-        return turns / (time.perf_counter() - started)
+        return turns / (time.process_time() - started)
 
 
 def decision_times(policy_path: Path, episodes: int, seed: int) -> dict:
@@ -120,9 +148,9 @@ def decision_times(policy_path: Path, episodes: int, seed: int) -> dict:
             state.probabilities()  # p(y|x) of the scene is part of the state (as in bench_decision.py)
             for name, strategy in (("rl", rl), ("dt-task", dt)):
                 state.cache.clear()  # each starts cold: no what-if result memoised by the other
-                started = time.perf_counter()
+                started = time.process_time()
                 strategy.choose(state, rng)
-                times[name].append(time.perf_counter() - started)
+                times[name].append(time.process_time() - started)
             _, _, done, _, info = env.step(int(rng.choice(np.flatnonzero(info["action_mask"]))))
     rl_ms, dt_ms = (1000 * float(np.median(times[k])) for k in ("rl", "dt-task"))
     return {"policy": source, "decisions": len(times["rl"]), "rl_ms": round(rl_ms, 3), "dt_task_ms": round(dt_ms, 3),
@@ -131,22 +159,27 @@ def decision_times(policy_path: Path, episodes: int, seed: int) -> dict:
 
 def main(argv=None) -> int:
     args = _parse(sys.argv[1:] if argv is None else argv)
+    # threadpoolctl limits the libraries loaded when the limit starts: load every BLAS first (the environment's
+    # imports bring scipy's), else its steps ran on two BLAS threads while regress's episodes, which set the
+    # limit per episode, ran on one (cho_solve 5x slower in the environment on this machine)
+    import dialog.experiments.episodes  # noqa: F401
+    import dialog.gym_env  # noqa: F401
     from dialog.threads import one_blas_thread
 
     load_before = os.getloadavg()[0]
     with one_blas_thread():
-        loop = loop_turns_per_second(args.episodes, args.seed)
-        with_whatif = env_steps_per_second(True, args.episodes, args.seed)
-        without = env_steps_per_second(False, args.episodes, args.seed)
+        speeds = repeated_pairs(args.pairs, args.episodes, args.seed)
         decisions = decision_times(args.policy, args.episodes, args.seed)
-    result = {"episodes": args.episodes, "loop_turns_per_s": round(loop, 2),
-              "env_steps_per_s_whatif": round(with_whatif, 2), "env_steps_per_s_no_whatif": round(without, 2),
-              "env_whatif_over_loop": round(with_whatif / loop, 3), "env_no_whatif_over_loop": round(without / loop, 3),
-              **decisions, "load_average": [round(load_before, 2), round(os.getloadavg()[0], 2)]}
-    print(f"dialog loop (regress, DT-task choosing): {loop:.1f} turns/s")
-    print(f"Questioning-v0, the same episodes and choices, with the what-if observation: {with_whatif:.1f} steps/s "
-          f"({with_whatif / loop:.2f} x the loop)")
-    print(f"Questioning-v0 without it: {without:.1f} steps/s ({without / loop:.2f} x the loop)")
+    result = {"episodes": args.episodes, **speeds, **decisions,
+              "load_average": [round(load_before, 2), round(os.getloadavg()[0], 2)]}
+    low, high = speeds["env_whatif_over_loop_range"]
+    print(f"CPU time, medians of {args.pairs} repetitions of each measurement:")
+    print(f"dialog loop (regress, DT-task choosing): {speeds['loop_turns_per_s']:.1f} turns/s")
+    print(f"Questioning-v0, the same episodes and choices, with the what-if observation: "
+          f"{speeds['env_steps_per_s_whatif']:.1f} steps/s ({speeds['env_whatif_over_loop']:.2f} x the loop; "
+          f"{low:.2f}-{high:.2f} over the repetitions)")
+    print(f"Questioning-v0 without it: {speeds['env_steps_per_s_no_whatif']:.1f} steps/s "
+          f"({speeds['env_no_whatif_over_loop']:.2f} x the loop)")
     print(f"decision time over {decisions['decisions']} states: RL questioner {decisions['rl_ms']:.2f} ms, DT-task "
           f"{decisions['dt_task_ms']:.2f} ms (ratio {decisions['rl_over_dt_task']:.2f}); policy {decisions['policy']}")
     print(f"load average {result['load_average'][0]} -> {result['load_average'][1]}")

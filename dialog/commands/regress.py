@@ -95,6 +95,9 @@ def run(args: argparse.Namespace) -> int:
         outcome = run_suite(kind, suite, options, original)
         report = kind.report(outcome, out)[0]
     print(f"{suite.name}: {outcome.count} runs in {outcome.seconds:.1f} s; report {report}")
+    sweep = outcome.extra.get("sweep")
+    if sweep is not None:
+        print(f"  {sweep.line()}")
     for finding in outcome.findings:
         ps = ", ".join(f"{c.b} p={c.p:.3g}" + ("" if c.p_holm is None else f" (Holm {c.p_holm:.3g})")
                        for c in finding.comparisons)
@@ -111,8 +114,10 @@ def run(args: argparse.Namespace) -> int:
         print(failures.verdict())
     if args.json:
         data = {} if suite.kind == "recipes" else {"data_seed": suite.data_seed}  # recipes render no data sets
+        use = {} if sweep is None else {"episodes_per_second": round(sweep.runs_per_second, 3),
+                                        "cpu_use": round(sweep.cpu_use, 3)}
         print(json.dumps({"suite": suite.name, "episodes": outcome.count, "seconds": round(outcome.seconds, 2),
-                          **data, "passed": not failures, "failures": failures}))
+                          **data, **use, "passed": not failures, "failures": failures}))
     return 1 if failures else 0
 
 

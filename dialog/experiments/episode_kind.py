@@ -2,13 +2,14 @@
 
 from __future__ import annotations
 
+import os
 import time
 from pathlib import Path
 
 from dialog.embodied import strategy_names_with_variants
 from dialog.experiments.analysis import evaluate_findings, summarise
 from dialog.experiments.figures import save_figures
-from dialog.experiments.kinds import RunOptions, SuiteKind, SuiteRun, register_kind
+from dialog.experiments.kinds import RunOptions, SuiteKind, SuiteRun, SweepUse, register_kind
 from dialog.experiments.pools import load_pools
 from dialog.experiments.report import markdown_report, write_episode_csvs
 from dialog.experiments.runner import RenderBar, episode_specs, run_locally, run_on_ray
@@ -45,13 +46,16 @@ class EpisodesKind(SuiteKind):
             load_pools(suite.task, suite.kitchen, suite.datasets, suite.plan_options, progress=bar,
                        data_seed=suite.data_seed)
         specs = episode_specs(suite, options.results)
+        sweep_started = time.perf_counter()
         if options.ray:
             results = run_on_ray(specs, options.ray, options.progress)
         else:
             results = run_locally(specs, options.workers, options.progress)
+        sweep = SweepUse(len(results), time.perf_counter() - sweep_started,
+                         sum(r["cpu_seconds"] for r in results), os.cpu_count() or 1)
         summaries = summarise(results, suite)
         return SuiteRun(suite, results, summaries, evaluate_findings(summaries, suite), len(results),
-                        time.perf_counter() - started)
+                        time.perf_counter() - started, extra={"sweep": sweep})
 
     def report(self, run: SuiteRun, folder: Path) -> list[Path]:
         table = write_episode_csvs(run.data, folder)

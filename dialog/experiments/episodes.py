@@ -78,7 +78,7 @@ def suite_teacher(options: dict, rng: np.random.Generator, clock=None, answer_de
 
 
 def run_episode(spec: EpisodeSpec, strategy: Strategy | None = None) -> dict:
-    """Run one episode; returns its spec, per-turn series, final accuracy and wall time.
+    """Run one episode; returns its spec, per-turn series, final accuracy, wall time and CPU time.
 
     ``strategy`` (default: the one ``spec`` names) is an already built strategy, e.g. IRL's MaxEnt policy,
     which the caller can read after the episode (dialog.experiments.irl_rollouts)."""
@@ -87,7 +87,7 @@ def run_episode(spec: EpisodeSpec, strategy: Strategy | None = None) -> dict:
 
 
 def _run_episode(spec: EpisodeSpec, strategy: Strategy | None = None) -> dict:
-    started = time.perf_counter()
+    started, started_cpu = time.perf_counter(), time.process_time()
     pools = load_pools(spec.task, spec.kitchen, spec.dataset + 1, spec.plan, data_seed=spec.data_seed)
     condition = spec.condition
     scenes = -(-condition.turns // max(condition.change_every, 1))
@@ -109,7 +109,7 @@ def _run_episode(spec: EpisodeSpec, strategy: Strategy | None = None) -> dict:
                                strategy, config, transcript, rngs, say=lambda _: None, clock=clock).run()
     series = series_from_transcript(read_transcript(spec.transcript))
     return {"spec": asdict(spec), "label": spec.label, "series": series, "accuracy": result.accuracy,
-            "seconds": time.perf_counter() - started}
+            "seconds": time.perf_counter() - started, "cpu_seconds": time.process_time() - started_cpu}
 
 
 def series_from_transcript(records: list[dict]) -> dict[str, list]:

@@ -39,6 +39,32 @@ class RunOptions:
     progress: bool = True
 
 
+@dataclass(frozen=True)
+class SweepUse:
+    """How a sweep used the machine: its runs, their wall time together, the CPU time they spent, the cores.
+
+    ``cpu_use`` is the runs' own CPU time (measured inside each, wherever it ran) over wall time x cores:
+    1.0 keeps every core busy with the runs; process start-up and result passing count as idle.
+    """
+
+    runs: int
+    seconds: float
+    cpu_seconds: float
+    cores: int
+
+    @property
+    def runs_per_second(self) -> float:
+        return self.runs / self.seconds if self.seconds > 0 else 0.0
+
+    @property
+    def cpu_use(self) -> float:
+        return self.cpu_seconds / (self.seconds * self.cores) if self.seconds > 0 else 0.0
+
+    def line(self, what: str = "episodes") -> str:
+        return (f"{self.runs} {what} in {self.seconds:.1f} s: {self.runs_per_second:.2f} {what} per second; "
+                f"CPU use {self.cpu_use:.0%} of {self.cores} cores")
+
+
 @dataclass
 class SuiteRun:
     """What one run of a suite produced; ``data`` is the kind's own results (episodes, rows, trials)."""

@@ -35,6 +35,7 @@ from learning.whatif.laplace import (
     predict_weight_space,
     scene_kernels,
     scene_posterior,
+    stack_posteriors,
 )
 
 # The feature-query refits use a low-rank kernel when the answer has few features: an RBF kernel on up to
@@ -63,21 +64,27 @@ class FastEngine(WhatIfEngine):
 
 
 def pair_table(state) -> np.ndarray:
-    """[x, y, i, c]: p(c | scene object i) after adding <scene object x, concept y> to the training set."""
+    """[x, y, i, c]: p(c | scene object i) after adding <scene object x, concept y> to the training set.
+
+    Classifiers on the same features share their kernels (they share the training rows) and their one-site
+    updates run as one batch (``one_site_probabilities`` on ``stack_posteriors``).
+    """
     scene = state.scaled_scene()
     n_objects, n_concepts = len(scene), len(state.concepts)
     table = np.empty((n_objects, n_concepts, n_objects, n_concepts))
-    kernels = {}  # classifiers on the same features share their kernels (they share the training rows)
+    groups: dict[tuple, list[int]] = {}
     for c, concept in enumerate(state.concepts):
         model = state.concept_model(concept)
-        columns = state.model_columns(concept)
-        key = (tuple(columns), model.length_scale_)
-        if key not in kernels:
-            kernels[key] = scene_kernels(model.X_train_, scene[:, columns], model.length_scale_, model.variance)
-        posterior = scene_posterior(model, scene[:, columns], kernels[key])
-        signed = one_site_probabilities(posterior)  # [+1 / -1, x, i]
-        table[:, :, :, c] = signed[1][:, None, :]
-        table[:, c, :, c] = signed[0]
+        groups.setdefault((tuple(state.model_columns(concept)), model.length_scale_), []).append(c)
+    for (columns, length_scale), members in groups.items():
+        first = state.concept_model(state.concepts[members[0]])
+        kernels = scene_kernels(first.X_train_, scene[:, columns], length_scale, first.variance)
+        posteriors = [scene_posterior(state.concept_model(state.concepts[c]), scene[:, columns], kernels)
+                      for c in members]
+        signed = one_site_probabilities(stack_posteriors(posteriors))  # [g, +1 / -1, x, i]
+        for g, c in enumerate(members):
+            table[:, :, :, c] = signed[g, 1][:, None, :]
+            table[:, c, :, c] = signed[g, 0]
     return table
 
 

@@ -86,6 +86,16 @@ def scene_posterior(model: BinaryGPClassifier, scene: np.ndarray, kernels: tuple
     return ScenePosterior(K_ns.T @ model.grad_, K_ss - V.T @ V, cross, model.f_hat_, sw * sw)
 
 
+def stack_posteriors(posteriors: list[ScenePosterior]) -> ScenePosterior:
+    """Several classifiers' posteriors over the same scene (and the same training rows) as one batch."""
+    first = posteriors[0]
+
+    def stacked(name: str):
+        return None if getattr(first, name) is None else np.stack([getattr(p, name) for p in posteriors])
+
+    return ScenePosterior(stacked("mean"), stacked("cov"), stacked("cross"), stacked("mode"), stacked("W"))
+
+
 def one_site_probabilities(posterior: ScenePosterior, max_steps: int = 50, tolerance: float = 1e-10) -> np.ndarray:
     """p(y=1 | x_i) after adding scene object j with label t: array [t, j, i], t = 0 for +1 and 1 for -1.
 
@@ -97,34 +107,43 @@ def one_site_probabilities(posterior: ScenePosterior, max_steps: int = 50, toler
        scene means by Cov'(scene, train) r, Cov' being the covariance after the new site (rank-one again).
     The variances keep the old sites' precisions W (a first-order correction for their move was tried:
     it halves the mean error but sometimes overshoots, doubling the largest one).
+
+    A batch of classifiers (``stack_posteriors``: a leading axis g on every array) gives [g, t, j, i],
+    all in one pass: no Python loop over the classifiers.
     """
-    mean, cov = posterior.mean, posterior.cov
-    if len(mean) == 0:
-        return np.zeros((2, 0, 0))
-    site_variance = np.maximum(np.diag(cov), MIN_VARIANCE)
-    targets = np.array([1.0, -1.0])[:, None]
-    f = np.broadcast_to(mean, (2, len(mean))).copy()
-    for _ in range(max_steps):  # maximise log N(f; mu_j, s_j) + log sigma(t f): concave, 1-D per (t, j)
+    if posterior.mean.ndim == 1:
+        return one_site_probabilities(stack_posteriors([posterior]), max_steps, tolerance)[0]
+    mean, cov = posterior.mean, posterior.cov  # (g, m), (g, m, m)
+    n_batch, m = mean.shape
+    if m == 0:
+        return np.zeros((n_batch, 2, 0, 0))
+    diagonal = np.diagonal(cov, axis1=1, axis2=2)  # (g, m)
+    site_variance = np.maximum(diagonal, MIN_VARIANCE)[:, None, :]  # (g, 1, m)
+    targets = np.array([1.0, -1.0])[None, :, None]
+    mean_t = mean[:, None, :]
+    f = np.broadcast_to(mean_t, (n_batch, 2, m)).copy()
+    for _ in range(max_steps):  # maximise log N(f; mu_j, s_j) + log sigma(t f): concave, 1-D per (g, t, j)
         pi = sigmoid(f)
-        gradient = -(f - mean) / site_variance + (targets + 1.0) / 2.0 - pi
+        gradient = -(f - mean_t) / site_variance + (targets + 1.0) / 2.0 - pi
         step = gradient / (1.0 / site_variance + pi * (1.0 - pi))
         f += step
         if np.max(np.abs(step), initial=0.0) < tolerance:
             break
     pi = sigmoid(f)
     w = pi * (1.0 - pi)
-    shift = (f - mean) / site_variance  # (2, m): mean update per unit of Sigma[:, j]
-    shrink = w / (1.0 + w * site_variance)  # (2, m)
-    new_mean = mean[None, None, :] + cov[None, :, :] * shift[:, :, None]
+    shift = (f - mean_t) / site_variance  # (g, 2, m): mean update per unit of Sigma[:, j]
+    shrink = w / (1.0 + w * site_variance)  # (g, 2, m)
+    new_mean = mean[:, None, None, :] + cov[:, None, :, :] * shift[..., None]  # [g, t, j, i]
     if posterior.cross is not None:
         assert posterior.mode is not None and posterior.W is not None, "cross, mode and W are set together"
-        moved = posterior.mode[None, None, :] + posterior.cross.T[None, :, :] * shift[:, :, None]  # [t, j, n]
-        residual = sigmoid(posterior.mode) - sigmoid(moved) + posterior.W * (moved - posterior.mode)
-        # Cov(scene, train) r for every (t, j), as one matrix product
-        along = (residual.reshape(-1, residual.shape[-1]) @ posterior.cross).reshape(residual.shape[:2] + (-1,))
-        at_site = np.take_along_axis(along, np.arange(len(mean))[None, :, None], axis=2)[:, :, 0]  # (t, j)
-        new_mean += along - cov[None, :, :] * (shrink * at_site)[:, :, None]
-    new_variance = np.diag(cov)[None, None, :] - cov[None, :, :] ** 2 * shrink[:, :, None]
+        cross, mode, W = posterior.cross, posterior.mode[:, None, None, :], posterior.W[:, None, None, :]
+        moved = mode + cross.transpose(0, 2, 1)[:, None, :, :] * shift[..., None]  # [g, t, j, n]
+        residual = sigmoid(mode) - sigmoid(moved) + W * (moved - mode)
+        # Cov(scene, train) r for every (g, t, j), one matrix product per classifier
+        along = np.matmul(residual.reshape(n_batch, 2 * m, -1), cross).reshape(n_batch, 2, m, m)
+        at_site = np.diagonal(along, axis1=2, axis2=3)  # (g, t, j)
+        new_mean += along - cov[:, None, :, :] * (shrink * at_site)[..., None]
+    new_variance = diagonal[:, None, None, :] - cov[:, None, :, :] ** 2 * shrink[..., None]
     return probit_probability(new_mean, new_variance)
 
 

@@ -94,8 +94,11 @@ def test_a_tiny_suite_runs_end_to_end(tmp_path, capsys):
     code = main(["regress", "--suite", str(write_suite(tmp_path)), "--results", str(tmp_path / "out"),
                  "--workers", "1", "--no-progress", "--json"])
     assert code == 0
-    summary = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
+    out = capsys.readouterr().out.strip().splitlines()
+    summary = json.loads(out[-1])
     assert summary["suite"] == "tiny" and summary["episodes"] == 4 and summary["passed"]
+    assert summary["episodes_per_second"] > 0 and 0 < summary["cpu_use"] <= 1.0
+    assert any(line.strip().startswith("4 episodes in ") and "episodes per second; CPU use" in line for line in out)
     report = (tmp_path / "out" / "report.md").read_text()
     assert "f1: passive beats active" in report and "curves-static.png" in report
     assert (tmp_path / "out" / "curves-static.png").stat().st_size > 1000
@@ -133,6 +136,15 @@ def test_the_same_suite_runs_on_a_local_ray_instance(tmp_path, capsys):
         return [",".join(row.split(",")[:10]) for row in rows]
 
     assert without_timing(on_ray) == without_timing(here)
+
+
+def test_sweep_use_is_the_runs_cpu_time_over_wall_time_and_cores():
+    from dialog.experiments.kinds import SweepUse
+
+    sweep = SweepUse(runs=80, seconds=10.0, cpu_seconds=17.0, cores=2)
+    assert sweep.runs_per_second == 8.0 and sweep.cpu_use == pytest.approx(0.85)
+    assert sweep.line() == "80 episodes in 10.0 s: 8.00 episodes per second; CPU use 85% of 2 cores"
+    assert SweepUse(0, 0.0, 0.0, 2).cpu_use == 0.0
 
 
 def test_scripted_feature_answers_follow_the_user_model():
