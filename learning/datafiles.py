@@ -12,6 +12,8 @@ from __future__ import annotations
 
 import difflib
 import math
+import os
+import re
 import sys
 from collections.abc import Iterable
 from pathlib import Path
@@ -23,8 +25,14 @@ if sys.version_info >= (3, 11):
 else:  # Python 3.10
     import tomli as tomllib
 
-__all__ = ["REQUIRED", "DataFileError", "MissingDataFileError", "check_keys", "flag", "integer", "number",
-           "numbers", "read_toml", "section", "tables", "text", "texts", "value_range"]
+__all__ = ["NAME_RULE", "REQUIRED", "DataFileError", "MissingDataFileError", "check_keys", "check_name", "flag",
+           "integer", "inside", "name", "number", "numbers", "read_toml", "section", "tables", "text", "texts",
+           "value_range"]
+
+#: the one pattern for every name that becomes part of a path (suite, study, condition, participant)
+NAME_PATTERN = re.compile(r"[A-Za-z0-9_][A-Za-z0-9._-]{0,63}")
+NAME_RULE = ("1 to 64 letters, digits, '-', '_' or '.', starting with a letter, digit or '_' "
+             "(no spaces, path separators or newlines)")
 
 
 class _Required:
@@ -58,6 +66,32 @@ def read_toml(path: str | Path, what: str = "data") -> dict:
         return tomllib.loads(content)
     except tomllib.TOMLDecodeError as error:
         raise DataFileError(f"{path}: not valid TOML ({error})") from None
+    except RecursionError:
+        raise DataFileError(f"{path}: not valid TOML for teachbot: arrays or tables nested too deeply "
+                            "(a data file needs a few levels at most)") from None
+
+
+def check_name(value, what: str, where: str) -> str:
+    """A name that becomes part of a path: a full match of :data:`NAME_PATTERN`, else one line saying the rule."""
+    if not isinstance(value, str) or NAME_PATTERN.fullmatch(value) is None:
+        shown = repr(value) if len(repr(value)) <= 80 else f"{repr(value)[:80]}... ({len(value)} characters)"
+        raise DataFileError(f"{where}: {what} {shown} is not accepted; a name is {NAME_RULE}")
+    return value
+
+
+def name(table: dict, key: str, where: str, default=REQUIRED, what: str | None = None) -> str:
+    """A field whose value names a file or folder (:func:`check_name`)."""
+    present, value = _present(table, key, where, default)
+    return check_name(value, what or f"'{key}'", where) if present else value
+
+
+def inside(folder: str | Path, path: str | Path, what: str) -> Path:
+    """``path`` if it stays inside ``folder`` once symbolic links are followed, else one line naming both."""
+    base, full = os.path.realpath(folder), os.path.realpath(path)
+    if os.path.commonpath([base, full]) != base:
+        raise DataFileError(f"{path}: the {what} would be written outside its folder {folder} (it resolves to "
+                            f"{full}); a symbolic link may point out of it")
+    return Path(path)
 
 
 def check_keys(table: dict, where: str, required: Iterable[str] = (), optional: Iterable[str] = ()) -> None:

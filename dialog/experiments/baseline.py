@@ -9,6 +9,7 @@ import numpy as np
 
 from dialog.experiments.analysis import CheckpointSummary
 from dialog.experiments.suite import SUITE_DIR, Suite, SuiteError
+from learning.datafiles import inside
 from learning.errors import SettingsError
 from learning.strategies.rl_questioner import PREFIX as RL_PREFIX
 
@@ -17,7 +18,9 @@ DEFAULT_TOLERANCE = 0.05
 
 
 def baseline_path(suite: Suite) -> Path:
-    return BASELINE_DIR / f"{suite.name}.json"
+    """``dialog/suites/baselines/<name>.json``; the suite's name is a file name (no separators), and a link that
+    leads out of the baselines folder is refused."""
+    return inside(BASELINE_DIR, BASELINE_DIR / f"{suite.name}.json", "baseline")
 
 
 def make_baseline(suite: Suite, summaries: list[CheckpointSummary], tolerance: float = DEFAULT_TOLERANCE) -> dict:
