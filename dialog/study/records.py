@@ -60,10 +60,8 @@ def read_study_transcript(path: Path, expected: dict, session: dict) -> tuple[di
     condition fixes (:func:`expected_session`): a header that names another participant, condition, order,
     strategy, seed or number of turns, a duplicated or extra turn and a malformed field are refused by name.
     """
-    try:
-        header, numbered = read_numbered_session(path, tolerate_partial_tail=True)
-    except RecursionError:
-        raise TranscriptError(f"{path}: a line nests JSON too deeply to be a teachbot record") from None
+    _check_utf8(path)
+    header, numbered = read_numbered_session(path, tolerate_partial_tail=True)
     if header is None:
         raise TranscriptError(f"{path}: line 1: no session header (expected the header teachbot study run writes)")
     _check_study_table(path, header.get("study"), expected, "session")
@@ -92,6 +90,21 @@ def read_study_transcript(path: Path, expected: dict, session: dict) -> tuple[di
             raise TranscriptError(f"{path}: line {line}: {error}") from None
         records.append(record)
     return header, records
+
+
+def _check_utf8(path: Path) -> None:
+    """Refuse bytes that are not UTF-8 in the complete lines of a record (a torn last line is left to the resume)."""
+    try:
+        raw = path.read_bytes()
+    except OSError as error:
+        raise TranscriptError(f"{path}: cannot read the transcript ({error.strerror or error})") from None
+    complete = raw[:raw.rfind(b"\n") + 1]
+    try:
+        complete.decode("utf-8")
+    except UnicodeDecodeError as error:
+        line = complete[:error.start].count(b"\n") + 1
+        raise TranscriptError(f"{path}: line {line}: not UTF-8 text (byte {error.start}; expected the JSON Lines "
+                              "teachbot writes)") from None
 
 
 def _json_lines(path: Path, what: str) -> list[tuple[int, object]]:
