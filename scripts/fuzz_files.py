@@ -215,7 +215,7 @@ class Fuzzer:
             raise SystemExit(f"fuzz_files: setting up with teachbot {' '.join(args)} failed ({code}):\n{output}")
 
     def plan(self, kind_list: list[Kind]) -> list[tuple]:
-        """Every case, drawn from --seed before any runs: (index, kind or "paths", mutation, rule-breaking?)."""
+        """Every case, drawn from --seed before any runs: (index, kind name or "paths", its own generator)."""
         rng = np.random.default_rng(self.options.seed)
         names = [k.name for k in kind_list] + ["paths"]
         cases = []
@@ -225,11 +225,9 @@ class Fuzzer:
             cases.append((index, name, case_rng))
         return cases
 
-    def run_case(self, spec, by_name: dict) -> Case:
+    def prepare(self, spec, by_name: dict, folder: Path) -> Case:
+        """Copy the kind's good files to ``folder`` and apply the case's mutation (the same for the same spec)."""
         index, name, rng = spec
-        folder = self.workdir / f"case-{index:05d}"
-        if name == "paths":
-            return self._path_case(index, folder, rng)
         kind = by_name[name]
         shutil.copytree(self.base / kind.folder, folder, symlinks=True)
         target = folder / kind.target
@@ -241,7 +239,15 @@ class Fuzzer:
         original = target.read_bytes()
         apply(target, rng)
         breaks = structured or (kind.byte_rules and target.read_bytes() != original)
-        case = Case(index, name, description, breaks)
+        return Case(index, name, description, breaks)
+
+    def run_case(self, spec, by_name: dict) -> Case:
+        index, name, rng = spec
+        folder = self.workdir / f"case-{index:05d}"
+        if name == "paths":
+            return self._path_case(index, folder, rng)
+        kind = by_name[name]
+        case = self.prepare(spec, by_name, folder)
         before = snapshot(folder, kind.recorded)
         for args in kind.commands:
             code, output = run_command(args, folder, self.options.timeout)
