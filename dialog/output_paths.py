@@ -194,6 +194,27 @@ def _read_only(folder: Path) -> bool:
         return False
 
 
+def superseded_name(path: str | Path) -> Path:
+    """``FILE.superseded-N`` with the first N not taken: where a recorded file is kept when it is replaced."""
+    path = Path(path)
+    number = 1
+    while path.with_name(f"{path.name}.superseded-{number}").exists():
+        number += 1
+    return path.with_name(f"{path.name}.superseded-{number}")
+
+
+def keep_superseded(path: str | Path, what: str) -> Path | None:
+    """Rename a recorded ``path`` that holds something to :func:`superseded_name` before it is replaced; returns
+    the new name (None when there was nothing to keep). The caller says so."""
+    path = Path(path)
+    if not path.is_file() or path.stat().st_size == 0:
+        return None
+    target = superseded_name(path)
+    with writing(path, what):
+        path.rename(target)
+    return target
+
+
 def make_parent(path: str | Path, what: str) -> Path:
     """Create the missing folders above the output file ``path`` (the one rule: outputs are checked with
     :func:`check_writable` before the work starts, and their folders are created when they are written)."""

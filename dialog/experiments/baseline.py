@@ -3,12 +3,14 @@
 from __future__ import annotations
 
 import json
+import sys
 from pathlib import Path
 
 import numpy as np
 
 from dialog.experiments.analysis import CheckpointSummary
 from dialog.experiments.suite import SUITE_DIR, Suite, SuiteError
+from dialog.output_paths import keep_superseded
 from learning.datafiles import inside
 from learning.errors import SettingsError
 from learning.strategies.rl_questioner import PREFIX as RL_PREFIX
@@ -37,9 +39,14 @@ def make_baseline(suite: Suite, summaries: list[CheckpointSummary], tolerance: f
 
 
 def write_baseline(suite: Suite, summaries: list[CheckpointSummary], path: Path | None = None) -> Path:
+    """Store the baseline; one already there is first kept as ``<name>.json.superseded-N`` (said on stderr)."""
     path = path or baseline_path(suite)
     path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(json.dumps(make_baseline(suite, summaries), indent=1) + "\n", encoding="utf-8")
+    text = json.dumps(make_baseline(suite, summaries), indent=1) + "\n"
+    if path.is_file() and path.read_text(encoding="utf-8", errors="replace") != text:
+        kept = keep_superseded(path, "baseline")
+        print(f"the earlier baseline is kept as {kept}", file=sys.stderr, flush=True)
+    path.write_text(text, encoding="utf-8")
     return path
 
 

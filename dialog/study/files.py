@@ -17,7 +17,7 @@ from dataclasses import dataclass
 from importlib import metadata
 from pathlib import Path
 
-from dialog.output_paths import writing
+from dialog.output_paths import superseded_name, writing
 from dialog.study.records import expected_session, read_abort_note, read_questionnaire, read_study_transcript
 from learning import datafiles as df
 from learning.errors import OutputPathError, TeachbotError, TranscriptError
@@ -167,10 +167,7 @@ def supersede(files: SessionFiles) -> list[Path]:
     """Rename a session's files ``*.superseded-N`` (kept in the record) so that it can be run again."""
     moved = []
     for path in files.existing():
-        number = 1
-        while path.with_name(f"{path.name}.superseded-{number}").exists():
-            number += 1
-        target = path.with_name(f"{path.name}.superseded-{number}")
+        target = superseded_name(path)
         with writing(path, "superseded session record"):
             path.rename(target)
         moved.append(target)
