@@ -51,6 +51,8 @@ def run(args: argparse.Namespace) -> int:
     export = None
     if args.export is not None:
         export = check_writable(page_path(args.export, "scene.html"), "scene page")
+    if args.screenshot is not None:
+        check_writable(args.screenshot, "screenshot")
     environment = SimulatedKitchen(task=args.task, kitchen=args.kitchen, seed=args.seed)
     try:
         scene = environment.next_scene(episode_generators(args.seed)["scenes"])

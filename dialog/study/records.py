@@ -92,8 +92,15 @@ def read_study_transcript(path: Path, expected: dict, session: dict) -> tuple[di
     return header, records
 
 
+def _regular(path: Path, what: str) -> None:
+    """Refuse a record that is a folder, a FIFO or a device before opening it (reading a FIFO would block)."""
+    if path.exists() and not path.is_file():
+        raise TranscriptError(f"{path}: not a regular file (expected the {what} teachbot study run wrote)")
+
+
 def _check_utf8(path: Path) -> None:
     """Refuse bytes that are not UTF-8 in the complete lines of a record (a torn last line is left to the resume)."""
+    _regular(path, "transcript")
     try:
         raw = path.read_bytes()
     except OSError as error:
@@ -108,6 +115,7 @@ def _check_utf8(path: Path) -> None:
 
 
 def _json_lines(path: Path, what: str) -> list[tuple[int, object]]:
+    _regular(path, what)
     try:
         raw = path.read_bytes()
     except OSError as error:

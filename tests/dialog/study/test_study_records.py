@@ -44,8 +44,8 @@ def copy(recorded, tmp_path):
 
 
 def checksums(folder: Path) -> dict:
-    return {str(p.relative_to(folder)): hashlib.sha256(p.read_bytes()).hexdigest()
-            for p in sorted(folder.rglob("*")) if p.is_file() and "report" not in p.parts}
+    return {str(p.relative_to(folder)): hashlib.sha256(p.read_bytes()).hexdigest() if p.is_file() else "not a file"
+            for p in sorted(folder.rglob("*")) if not p.is_dir() and "report" not in p.parts}
 
 
 def one_line(text: str) -> str:
@@ -150,6 +150,11 @@ def _extra_turn(folder):
     (folder / SESSION).write_text("".join(lines) + json.dumps(record) + "\n")
 
 
+def _fifo(path: Path) -> None:
+    path.unlink(missing_ok=True)
+    os.mkfifo(path)  # reading it would block: it must be refused unopened
+
+
 DAMAGES = {
     "note after_turns 'abc'": (lambda f: _note(f, after_turns="abc"), "'after_turns' is \"abc\" (expected a whole"),
     "note after_turns a list": (lambda f: _note(f, after_turns=[1]), "'after_turns' is [1]"),
@@ -180,6 +185,10 @@ DAMAGES = {
     "header turns edited": (_set(SESSION, 0, "turns", 9, "session"), "the session header's 'turns' is 9 (expected 8"),
     "transcript 0xFF bytes": (lambda f: (f / SESSION).write_bytes((f / SESSION).read_bytes().replace(
         b'"question": "', b'"question": "\xff', 1)), "line 2: not UTF-8 text"),
+    "transcript a FIFO": (lambda f: _fifo(f / SESSION), "1-dt-task.jsonl: not a regular file (expected the "
+                                                        "transcript"),
+    "questionnaire a FIFO": (lambda f: _fifo(f / ANSWERS), "not a regular file (expected the questionnaire answers"),
+    "note a FIFO": (lambda f: _fifo(f / NOTE), "not a regular file (expected the abort note"),
     "transcript nested 100000 deep": (_write_line(SESSION, 2, "[" * 100000 + "\n"), "line 3 nests JSON too deeply"),
 }
 
