@@ -23,6 +23,7 @@ import stat
 from contextlib import contextmanager
 from pathlib import Path
 
+from learning.datafiles import lookup_problem
 from learning.errors import OutputPathError
 
 #: errors that mean "this output can't be written here" (anything else from a write is a bug)
@@ -68,43 +69,9 @@ def file_argument(text: str) -> Path:
 
 
 def path_problem(path: str | Path) -> str:
-    """Why ``path`` can't even be looked up ("" when it can): a name or a path too long, a loop of links."""
-    text = os.fspath(path)
-    try:
-        os.stat(text)
-    except FileNotFoundError:
-        return ""
-    except NotADirectoryError:
-        return ""  # reported by the caller: a parent that is a file
-    except OSError as error:
-        if error.errno == errno.ENAMETOOLONG:
-            limit = _name_max(text)
-            longest = max(Path(text).parts, key=len, default="")
-            if len(longest.encode("utf-8", "surrogateescape")) > limit:
-                return (f"a name in the path is {len(longest.encode('utf-8', 'surrogateescape'))} bytes long; "
-                        f"this file system allows at most {limit} (ENAMETOOLONG)")
-            return (f"the path is {len(text.encode('utf-8', 'surrogateescape')):,} bytes long; this system "
-                    f"allows at most {_path_max(text):,} (ENAMETOOLONG)")
-        if error.errno == errno.ELOOP:
-            return "symbolic links in the path loop (or nest too deeply) (ELOOP)"
-        if error.errno == errno.EACCES:
-            return ""  # reported by the caller: no permission
-        raise
-    return ""
-
-
-def _name_max(text: str) -> int:
-    try:
-        return os.pathconf(_existing_ancestor(Path(os.path.dirname(text) or ".")), "PC_NAME_MAX")
-    except (OSError, ValueError):
-        return 255
-
-
-def _path_max(text: str) -> int:
-    try:
-        return os.pathconf("/", "PC_PATH_MAX") - 1
-    except (OSError, ValueError):
-        return 4095
+    """Why ``path`` can't even be looked up ("" when it can): a name or a path too long, a loop of links
+    (``learning.datafiles.lookup_problem``, which data files use too)."""
+    return lookup_problem(path)
 
 
 def special_file(path: str | Path) -> str:

@@ -11,6 +11,7 @@ keys list the accepted ones and suggest the nearest ("did you mean").
 from __future__ import annotations
 
 import difflib
+import errno
 import math
 import os
 import re
@@ -47,9 +48,45 @@ class MissingDataFileError(DataFileError, FileNotFoundError):
     """A data file does not exist (still a ValueError for the command line, and a FileNotFoundError)."""
 
 
+def lookup_problem(path: str | Path) -> str:
+    """Why ``path`` can't even be looked up ("" when it can, or when it is just missing): a name longer than the
+    file system allows, a path longer than the system allows, or symbolic links that loop."""
+    text = os.fspath(path)
+    try:
+        os.stat(text)
+    except (FileNotFoundError, NotADirectoryError, PermissionError):
+        return ""  # the callers say these in their own words
+    except OSError as error:
+        if error.errno == errno.ENAMETOOLONG:
+            longest = max((len(part.encode("utf-8", "surrogateescape")) for part in Path(text).parts), default=0)
+            limit = _limit(text, "PC_NAME_MAX", 255)
+            if longest > limit:
+                return f"a name in the path is {longest} bytes long; this file system allows at most {limit} " \
+                       "(ENAMETOOLONG)"
+            return (f"the path is {len(text.encode('utf-8', 'surrogateescape')):,} bytes long; this system allows "
+                    f"at most {_limit('/', 'PC_PATH_MAX', 4096) - 1:,} (ENAMETOOLONG)")
+        if error.errno == errno.ELOOP:
+            return "symbolic links in the path loop (or nest too deeply) (ELOOP)"
+        raise
+    return ""
+
+
+def _limit(text: str, name: str, default: int) -> int:
+    folder = os.path.dirname(text) or "."
+    while folder and not os.path.isdir(folder) and folder != os.path.dirname(folder):
+        folder = os.path.dirname(folder) or "."
+    try:
+        return os.pathconf(folder if os.path.isdir(folder) else "/", name)
+    except (OSError, ValueError):
+        return default
+
+
 def read_toml(path: str | Path, what: str = "data") -> dict:
     """The parsed TOML file; one-line DataFileError when it is missing, a folder, binary, not UTF-8 or not TOML."""
     path = Path(path)
+    problem = lookup_problem(path)
+    if problem:
+        raise DataFileError(f"{what} file {str(path)[:160]}: cannot be read: {problem}")
     if not path.exists():
         raise MissingDataFileError(f"{what} file {path} does not exist")
     if not path.is_file():

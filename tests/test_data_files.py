@@ -255,3 +255,14 @@ def test_deeply_nested_brackets_in_a_toml_file_are_one_line_not_a_recursion_erro
     with pytest.raises(DataFileError, match="deep.toml: not valid TOML for teachbot: arrays or tables nested too "
                                             "deeply"):
         read_toml(deep, "suite")
+
+
+def test_a_data_file_behind_a_link_loop_or_with_a_name_too_long_says_so_not_does_not_exist(tmp_path):
+    """Issue 24, case 6: a symbolic link loop was "does not exist"; a 300-character name raised OSError."""
+    (tmp_path / "a.toml").symlink_to(tmp_path / "b.toml")
+    (tmp_path / "b.toml").symlink_to(tmp_path / "a.toml")
+    with pytest.raises(DataFileError, match=r"study file .*a.toml: cannot be read: symbolic links in the path loop"):
+        read_toml(tmp_path / "a.toml", "study")
+    with pytest.raises(DataFileError, match="cannot be read: a name in the path is 305 bytes long; this file system "
+                                            "allows at most 255"):
+        read_toml(tmp_path / ("n" * 300 + ".toml"), "suite")
