@@ -114,11 +114,16 @@ def hostile_path(kind: str, folder: Path, suffix: str) -> str:
     if kind == "file as parent":
         (folder / "plain").write_text("x")
         return f"plain/x{suffix}"
+    if kind in ("/dev/null", "/dev/full"):
+        # a link to the device, never the device's own path: a teachbot that wrote its output beside the target
+        # and renamed it into place would replace the link, not the system's /dev/full (as root it could)
+        os.symlink(kind, folder / f"device{suffix}")
+        return f"device{suffix}"
     if kind == "symlink loop":
         os.symlink("loop-b", folder / "loop-a")
         os.symlink("loop-a", folder / "loop-b")
         return f"loop-a/x{suffix}"
-    return {"/dev/null": "/dev/null", "/dev/full": "/dev/full", "a folder": ".", "300-character name":
+    return {"a folder": ".", "300-character name":
             "n" * 300 + suffix, "path over 4096": "/".join(["p" * 200] * 22) + f"/x{suffix}", "newdir/": "newdir/",
             "/proc": f"/proc/teachbot-fuzz{suffix}"}[kind]
 

@@ -66,11 +66,16 @@ def test_a_fifo_as_the_viewer_export_is_one_warning_and_the_demo_goes_on(tmp_pat
 
 
 @pytest.mark.parametrize("device", ["/dev/null", "/dev/full"])
-@pytest.mark.parametrize("option", ["demo --transcript", "teach --transcript", "view --export"])
-def test_a_device_as_an_output_file_is_refused(option, device, capsys):
-    assert main(FILE_OUTPUTS[option](device)) == 2
+@pytest.mark.parametrize("option", ["demo --transcript", "teach --transcript", "view --export", "learn-weights --out"])
+def test_a_device_as_an_output_file_is_refused(option, device, tmp_path, capsys):
+    # through a link to the device: a teachbot that renamed a finished file into place would replace the link,
+    # not the system's device (run as root, the bug this guards against replaced /dev/full itself)
+    link = tmp_path / f"device{SUFFIX[option]}"
+    link.symlink_to(device)
+    assert main(FILE_OUTPUTS[option](str(link))) == 2
     err = capsys.readouterr().err
-    assert err.count("\n") == 1 and f"{device}: cannot write the " in err and "it is a character device" in err
+    assert err.count("\n") == 1 and f"{link}: cannot write the " in err and "it is a character device" in err
+    assert link.is_symlink() and Path(device).is_char_device()
 
 
 def _long_name(tmp_path: Path, suffix: str) -> tuple[str, str]:
