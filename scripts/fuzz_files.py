@@ -312,6 +312,8 @@ def main(argv=None) -> int:
     parser.add_argument("--seed", type=int, default=0, help="the same seed gives the same cases (default 0)")
     parser.add_argument("--workers", type=int, default=2, help="cases run at once (default 2)")
     parser.add_argument("--timeout", type=float, default=60.0, help="seconds a command may take before it is a hang")
+    parser.add_argument("--kinds", nargs="+", default=None, metavar="KIND",
+                        help="run only the cases of these kinds (the same cases a full run of --cases has)")
     parser.add_argument("--json", action="store_true", help="end with one JSON line of the counts")
     options = parser.parse_args(argv)
     started = time.perf_counter()
@@ -320,7 +322,8 @@ def main(argv=None) -> int:
         kind_list = fuzzer.setup()
         by_name = {kind.name: kind for kind in kind_list}
         with ThreadPoolExecutor(max_workers=max(1, options.workers)) as pool:
-            cases = list(pool.map(lambda spec: fuzzer.run_case(spec, by_name), fuzzer.plan(kind_list)))
+            plan = [spec for spec in fuzzer.plan(kind_list) if options.kinds is None or spec[1] in options.kinds]
+            cases = list(pool.map(lambda spec: fuzzer.run_case(spec, by_name), plan))
     summary = summarise(sorted(cases, key=lambda c: c.index), time.perf_counter() - started)
     if options.json:
         print(json.dumps(summary, ensure_ascii=True))
