@@ -1,7 +1,14 @@
 """Paths the tool writes: checked before the first turn, and every write error as one clear message.
 
 ``check_writable(path, what)`` refuses, up front, a path that is a folder, a
-parent that is a file, a read-only or inaccessible folder and a full disk.
+parent that is a file, a read-only or inaccessible folder and a full disk; an
+output file must be a regular file or new (a FIFO, a device or a socket is
+refused without being opened), and a name too long for the file system, a
+path over the system's limit and a loop of symbolic links each get their own
+message. ``file_argument`` is the ``type=`` of every command-line option
+naming an output file: ``newdir/`` (a trailing separator) is a folder, not a
+file name. Every command checks its outputs this way before its work starts
+and creates missing folders as it writes (one rule, docs/dialog.md).
 ``writing(path, what)`` turns an ``OSError`` raised while writing into an
 :class:`~learning.errors.OutputPathError` naming the path and the cause, e.g.
 ``runs/a.jsonl: cannot write the transcript: no space left on device (ENOSPC)``.
@@ -9,11 +16,14 @@ parent that is a file, a read-only or inaccessible folder and a full disk.
 
 from __future__ import annotations
 
+import argparse
 import errno
 import os
+import stat
 from contextlib import contextmanager
 from pathlib import Path
 
+from learning.datafiles import lookup_problem
 from learning.errors import OutputPathError
 
 #: errors that mean "this output can't be written here" (anything else from a write is a bug)
@@ -28,13 +38,52 @@ def cause(code: int) -> str:
 
 def output_error(path: str | Path, what: str, code: int, detail: str = "") -> OutputPathError:
     """The one-line message for ``path``; ``detail`` says more than the errno does (which parent, say)."""
-    return OutputPathError(f"{path}: cannot write the {what}: {detail or cause(code)}")
+    return OutputPathError(f"{shown_path(path)}: cannot write the {what}: {detail or cause(code)}")
+
+
+def shown_path(path: str | Path) -> str:
+    """``path`` as a message shows it: in full up to 160 characters, else its start and end around "..."."""
+    text = os.fspath(path)
+    return text if len(text) <= 160 else f"{text[:80]}...{text[-60:]}"
 
 
 def from_os_error(error: OSError, path: str | Path, what: str) -> OutputPathError:
     """The message for an ``OSError`` raised while writing ``path`` (or a file inside it)."""
     named = error.filename if error.filename not in (None, "") else path
     return output_error(named, what, error.errno or errno.EIO)
+
+
+#: what a path that exists but is no regular file is, by its stat type
+SPECIAL_FILES = ((stat.S_ISFIFO, "a FIFO (named pipe)"), (stat.S_ISCHR, "a character device"),
+                 (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket"))
+
+
+def file_argument(text: str) -> Path:
+    """``type=`` for an option naming an output file: refuses a trailing separator (``newdir/`` is a folder)."""
+    if not text:
+        raise argparse.ArgumentTypeError("needs a file path, got an empty one")
+    if (text.endswith(os.sep) or (os.altsep and text.endswith(os.altsep))) and not os.path.isdir(text):
+        raise argparse.ArgumentTypeError(f"{text!r} ends in '{os.sep}', so it names a folder; give a file path "
+                                         f"such as {text.rstrip(os.sep) or 'runs'}{os.sep}out.jsonl")
+    return Path(text)
+
+
+def path_problem(path: str | Path) -> str:
+    """Why ``path`` can't even be looked up ("" when it can): a name or a path too long, a loop of links
+    (``learning.datafiles.lookup_problem``, which data files use too)."""
+    return lookup_problem(path)
+
+
+def special_file(path: str | Path) -> str:
+    """``"a FIFO (named pipe)"`` when ``path`` exists and is not a regular file or a folder, else ``""``."""
+    try:
+        mode = os.stat(path).st_mode
+    except OSError:
+        return ""
+    for test, kind in SPECIAL_FILES:
+        if test(mode):
+            return kind
+    return ""
 
 
 def _existing_ancestor(path: Path) -> Path:
@@ -63,6 +112,14 @@ def check_writable(path: str | Path, what: str, *, folder: bool = False) -> Path
     and some space left on its device.
     """
     path = Path(path)
+    problem = path_problem(path)
+    if problem:
+        return _refuse(path, what, errno.ENAMETOOLONG, problem)
+    kind = special_file(path)
+    if kind:
+        return _refuse(path, what, errno.EINVAL, f"it is {kind}, not a regular file; give the path of a file "
+                                                 f"to write (nothing was opened)" if not folder else
+                       f"it is {kind}, not a folder")
     if path.is_dir() and not folder:
         return _refuse(path, what, errno.EISDIR, "it is a folder; give a file path")
     if path.exists() and not path.is_dir() and folder:
@@ -75,10 +132,22 @@ def check_writable(path: str | Path, what: str, *, folder: bool = False) -> Path
         if _read_only(target):
             return _refuse(path, what, errno.EROFS, f"{target} is on a read-only file system (EROFS)")
         return _refuse(path, what, errno.EACCES, f"no permission to write {target} (EACCES)")
+    if _pseudo_file_system(ancestor):
+        return _refuse(path, what, errno.EINVAL, f"{ancestor} is on a file system of the kernel's (such as /proc or "
+                                                 "/sys) that holds no files of yours; choose a folder on a disk")
     free = _free_bytes(ancestor)
     if free == 0:
         return _refuse(path, what, errno.ENOSPC)
     return path
+
+
+def _pseudo_file_system(folder: Path) -> bool:
+    """True for /proc, /sys and the like: a file system with no blocks at all (its "free space" is always 0)."""
+    try:
+        stats = os.statvfs(folder)
+    except (OSError, AttributeError):
+        return False
+    return stats.f_blocks == 0 and stats.f_files == 0
 
 
 def _refuse(path: Path, what: str, code: int, detail: str = "") -> Path:
@@ -90,6 +159,36 @@ def _read_only(folder: Path) -> bool:
         return bool(os.statvfs(folder).f_flag & os.ST_RDONLY)
     except (OSError, AttributeError):
         return False
+
+
+def superseded_name(path: str | Path) -> Path:
+    """``FILE.superseded-N`` with the first N not taken: where a recorded file is kept when it is replaced."""
+    path = Path(path)
+    number = 1
+    while path.with_name(f"{path.name}.superseded-{number}").exists():
+        number += 1
+    return path.with_name(f"{path.name}.superseded-{number}")
+
+
+def keep_superseded(path: str | Path, what: str) -> Path | None:
+    """Rename a recorded ``path`` that holds something to :func:`superseded_name` before it is replaced; returns
+    the new name (None when there was nothing to keep). The caller says so."""
+    path = Path(path)
+    if not path.is_file() or path.stat().st_size == 0:
+        return None
+    target = superseded_name(path)
+    with writing(path, what):
+        path.rename(target)
+    return target
+
+
+def make_parent(path: str | Path, what: str) -> Path:
+    """Create the missing folders above the output file ``path`` (the one rule: outputs are checked with
+    :func:`check_writable` before the work starts, and their folders are created when they are written)."""
+    path = Path(path)
+    with writing(path, what):
+        path.parent.mkdir(parents=True, exist_ok=True)
+    return path
 
 
 @contextmanager

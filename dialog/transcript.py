@@ -164,6 +164,9 @@ def read_numbered_session(path: str | Path, tolerate_partial_tail: bool = False
                 break
             raise TranscriptError(f"{path}: line {number} is not a JSON record: {json_problem(error, line)}; every "
                                   "line of a transcript is one JSON object, as teachbot writes it") from None
+        except RecursionError:
+            raise TranscriptError(f"{path}: line {number} nests JSON too deeply to be a teachbot record; every line "
+                                  "of a transcript is one JSON object, as teachbot writes it") from None
         if not isinstance(record, dict):
             raise TranscriptError(f"{path}: line {number} is not a JSON object")
         if "session" in record:

@@ -11,7 +11,10 @@ keys list the accepted ones and suggest the nearest ("did you mean").
 from __future__ import annotations
 
 import difflib
+import errno
 import math
+import os
+import re
 import sys
 from collections.abc import Iterable
 from pathlib import Path
@@ -23,8 +26,14 @@ if sys.version_info >= (3, 11):
 else:  # Python 3.10
     import tomli as tomllib
 
-__all__ = ["REQUIRED", "DataFileError", "MissingDataFileError", "check_keys", "flag", "integer", "number",
-           "numbers", "read_toml", "section", "tables", "text", "texts", "value_range"]
+__all__ = ["NAME_RULE", "REQUIRED", "DataFileError", "MissingDataFileError", "check_keys", "check_name", "flag",
+           "integer", "inside", "name", "number", "numbers", "read_toml", "section", "tables", "text", "texts",
+           "value_range"]
+
+#: the one pattern for every name that becomes part of a path (suite, study, condition, participant)
+NAME_PATTERN = re.compile(r"[A-Za-z0-9_][A-Za-z0-9._-]{0,63}")
+NAME_RULE = ("1 to 64 letters, digits, '-', '_' or '.', starting with a letter, digit or '_' "
+             "(no spaces, path separators or newlines)")
 
 
 class _Required:
@@ -39,9 +48,45 @@ class MissingDataFileError(DataFileError, FileNotFoundError):
     """A data file does not exist (still a ValueError for the command line, and a FileNotFoundError)."""
 
 
+def lookup_problem(path: str | Path) -> str:
+    """Why ``path`` can't even be looked up ("" when it can, or when it is just missing): a name longer than the
+    file system allows, a path longer than the system allows, or symbolic links that loop."""
+    text = os.fspath(path)
+    try:
+        os.stat(text)
+    except (FileNotFoundError, NotADirectoryError, PermissionError):
+        return ""  # the callers say these in their own words
+    except OSError as error:
+        if error.errno == errno.ENAMETOOLONG:
+            longest = max((len(part.encode("utf-8", "surrogateescape")) for part in Path(text).parts), default=0)
+            limit = _limit(text, "PC_NAME_MAX", 255)
+            if longest > limit:
+                return f"a name in the path is {longest} bytes long; this file system allows at most {limit} " \
+                       "(ENAMETOOLONG)"
+            return (f"the path is {len(text.encode('utf-8', 'surrogateescape')):,} bytes long; this system allows "
+                    f"at most {_limit('/', 'PC_PATH_MAX', 4096) - 1:,} (ENAMETOOLONG)")
+        if error.errno == errno.ELOOP:
+            return "symbolic links in the path loop (or nest too deeply) (ELOOP)"
+        raise
+    return ""
+
+
+def _limit(text: str, name: str, default: int) -> int:
+    folder = os.path.dirname(text) or "."
+    while folder and not os.path.isdir(folder) and folder != os.path.dirname(folder):
+        folder = os.path.dirname(folder) or "."
+    try:
+        return os.pathconf(folder if os.path.isdir(folder) else "/", name)
+    except (OSError, ValueError):
+        return default
+
+
 def read_toml(path: str | Path, what: str = "data") -> dict:
     """The parsed TOML file; one-line DataFileError when it is missing, a folder, binary, not UTF-8 or not TOML."""
     path = Path(path)
+    problem = lookup_problem(path)
+    if problem:
+        raise DataFileError(f"{what} file {str(path)[:160]}: cannot be read: {problem}")
     if not path.exists():
         raise MissingDataFileError(f"{what} file {path} does not exist")
     if not path.is_file():
@@ -58,6 +103,32 @@ def read_toml(path: str | Path, what: str = "data") -> dict:
         return tomllib.loads(content)
     except tomllib.TOMLDecodeError as error:
         raise DataFileError(f"{path}: not valid TOML ({error})") from None
+    except RecursionError:
+        raise DataFileError(f"{path}: not valid TOML for teachbot: arrays or tables nested too deeply "
+                            "(a data file needs a few levels at most)") from None
+
+
+def check_name(value, what: str, where: str) -> str:
+    """A name that becomes part of a path: a full match of :data:`NAME_PATTERN`, else one line saying the rule."""
+    if not isinstance(value, str) or NAME_PATTERN.fullmatch(value) is None:
+        shown = repr(value) if len(repr(value)) <= 80 else f"{repr(value)[:80]}... ({len(value)} characters)"
+        raise DataFileError(f"{where}: {what} {shown} is not accepted; a name is {NAME_RULE}")
+    return value
+
+
+def name(table: dict, key: str, where: str, default=REQUIRED, what: str | None = None) -> str:
+    """A field whose value names a file or folder (:func:`check_name`)."""
+    present, value = _present(table, key, where, default)
+    return check_name(value, what or f"'{key}'", where) if present else value
+
+
+def inside(folder: str | Path, path: str | Path, what: str) -> Path:
+    """``path`` if it stays inside ``folder`` once symbolic links are followed, else one line naming both."""
+    base, full = os.path.realpath(folder), os.path.realpath(path)
+    if os.path.commonpath([base, full]) != base:
+        raise DataFileError(f"{path}: the {what} would be written outside its folder {folder} (it resolves to "
+                            f"{full}); a symbolic link may point out of it")
+    return Path(path)
 
 
 def check_keys(table: dict, where: str, required: Iterable[str] = (), optional: Iterable[str] = ()) -> None:

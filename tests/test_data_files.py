@@ -3,6 +3,7 @@ loaded through the real loader; the error is one line naming the file and the fi
 
 from __future__ import annotations
 
+import json
 import math
 from pathlib import Path
 
@@ -230,3 +231,38 @@ def test_a_recipe_task_refuses_a_non_finite_scene_setting(tmp_path):
                    "region_margin = nan")
     refused(load_recipe_setup, write(tmp_path, text, "serve-pasta.toml"), "[recipe_scenes]",
             "'region_margin' must be a finite number")
+
+
+@pytest.mark.parametrize("name", ["../../../../x", "/tmp/teachbot-suite", "smoke\n", ".hidden", "a/b", ""])
+def test_a_suite_name_is_a_file_name_not_a_path(tmp_path, capsys, monkeypatch, name):
+    """Issue 24, case 2: a suite's name names its results folder and baseline; a path is refused before any run."""
+    monkeypatch.chdir(tmp_path)
+    path = write(tmp_path, changed(SMOKE, 'name = "smoke"', f"name = {json.dumps(name)}"), "suite.toml")
+    error = regress_refuses(tmp_path, capsys, path, "suite name", "is not accepted; a name is 1 to 64 letters")
+    assert "\n" not in error
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["suite.toml"]  # no results folder anywhere
+
+
+def test_a_suite_condition_name_is_a_file_name_too(tmp_path, capsys):
+    regress_refuses(tmp_path, capsys, write(tmp_path, changed(SMOKE, 'name = "static"', 'name = "../static"'),
+                                            "suite.toml"), "condition name '../static' is not accepted")
+
+
+@pytest.mark.parametrize("nested", ["[" * 1000 + "]" * 1000, "{a = " * 400 + "1" + "}" * 400])
+def test_deeply_nested_brackets_in_a_toml_file_are_one_line_not_a_recursion_error(tmp_path, nested):
+    deep = tmp_path / "deep.toml"
+    deep.write_text("x = " + nested + "\n")
+    with pytest.raises(DataFileError, match="deep.toml: not valid TOML for teachbot: arrays or tables nested too "
+                                            "deeply"):
+        read_toml(deep, "suite")
+
+
+def test_a_data_file_behind_a_link_loop_or_with_a_name_too_long_says_so_not_does_not_exist(tmp_path):
+    """Issue 24, case 6: a symbolic link loop was "does not exist"; a 300-character name raised OSError."""
+    (tmp_path / "a.toml").symlink_to(tmp_path / "b.toml")
+    (tmp_path / "b.toml").symlink_to(tmp_path / "a.toml")
+    with pytest.raises(DataFileError, match=r"study file .*a.toml: cannot be read: symbolic links in the path loop"):
+        read_toml(tmp_path / "a.toml", "study")
+    with pytest.raises(DataFileError, match="cannot be read: a name in the path is 305 bytes long; this file system "
+                                            "allows at most 255"):
+        read_toml(tmp_path / ("n" * 300 + ".toml"), "suite")

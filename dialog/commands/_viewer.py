@@ -22,7 +22,7 @@ from contextlib import contextmanager
 from pathlib import Path
 
 from dialog.commands._arguments import seconds
-from dialog.output_paths import check_writable, from_os_error
+from dialog.output_paths import check_writable, file_argument, from_os_error, path_problem
 from learning.errors import OutputPathError
 
 
@@ -31,7 +31,7 @@ def add_viewer_option(parser: argparse.ArgumentParser) -> None:
     group = parser.add_argument_group("viewer")
     group.add_argument("--viewer", action="store_true",
                        help="show the kitchen live in meshcat (the URL is printed; it listens on 127.0.0.1 only)")
-    group.add_argument("--viewer-export", type=Path, default=None, metavar="HTML",
+    group.add_argument("--viewer-export", type=file_argument, default=None, metavar="HTML",
                        help="write the episode as one static HTML page with meshcat's animation (opens without "
                             "a server)")
     group.add_argument("--viewer-hold", type=seconds, default=None, metavar="SECONDS",
@@ -109,8 +109,9 @@ def stop_viewer(viewer) -> dict | None:
 
 
 def page_path(path: Path, name: str) -> Path:
-    """``path``, or ``path/name`` when ``path`` is a folder (said on standard error)."""
-    if path.is_dir():
+    """``path``, or ``path/name`` when ``path`` is a folder (said on standard error); a path that can't even be
+    looked up (a name too long, a loop of links) is refused by ``check_writable``."""
+    if not path_problem(path) and path.is_dir():
         print(f"{path} is a folder: the page goes to {path / name}", file=sys.stderr)
         return path / name
     return path

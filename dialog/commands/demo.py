@@ -15,6 +15,7 @@ from dialog.commands.teach import DEFAULT_STRATEGY
 from dialog.environment import SimulatedKitchen
 from dialog.experiments.runner import file_label
 from dialog.manager import DialogManager, episode_generators
+from dialog.output_paths import file_argument
 from dialog.settings import DEFAULTS, EpisodeSettings
 from dialog.teachers import OracleTeacher
 from dialog.transcript import FORMAT, TranscriptWriter
@@ -34,7 +35,7 @@ def register(commands) -> None:
                     "asked. Every turn goes to a transcript (JSON Lines); the same seed gives the same transcript.")
     add_episode_options(parser, STRATEGY_NAMES, DEFAULT_STRATEGY)
     add_time_options(parser)
-    parser.add_argument("--transcript", type=Path, default=None,
+    parser.add_argument("--transcript", type=file_argument, default=None,
                         help="transcript path (default runs/demo-<strategy>-seed<seed>.jsonl; a non-default "
                              "task, kitchen or --embodied-costs adds itself to the name)")
     add_weights_option(parser)

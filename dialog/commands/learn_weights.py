@@ -16,7 +16,7 @@ import time
 from pathlib import Path
 
 from dialog.commands._arguments import positive_int, seed
-from dialog.output_paths import check_writable, writing
+from dialog.output_paths import check_writable, file_argument, make_parent, writing
 from dialog.user_weights import UserWeights
 from learning.errors import OutputPathError, SettingsError
 
@@ -37,7 +37,8 @@ def register(commands) -> None:
     parser.add_argument("--demos", required=True, metavar="DIR_OR_shipped",
                         help="a directory of .json/.npz demonstrations (teachbot expert --out), one such file, or "
                              "'shipped' (learning/irl/expert-demos)")
-    parser.add_argument("--out", type=Path, required=True, metavar="FILE.toml", help="the weights file to write")
+    parser.add_argument("--out", type=file_argument, required=True, metavar="FILE.toml",
+                        help="the weights file to write")
     parser.add_argument("--method", choices=("trajectory", "per-turn"), default="trajectory",
                         help="trajectory (default): eq. 7.7 with rollouts of the dialog loop; per-turn: the "
                              "per-turn MaxEnt fit on the recorded candidates (see --policy)")
@@ -83,8 +84,6 @@ def run(args: argparse.Namespace, output_stream=None) -> int:
     out = output_stream or sys.stdout
     if args.out.suffix != ".toml":
         raise OutputPathError(f"--out {args.out}: a weights file must end in .toml")
-    if not args.out.parent.exists():
-        raise OutputPathError(f"--out {args.out}: the directory {args.out.parent} does not exist")
     method = getattr(args, "method", "per-turn")
     check_options(args, method)
     check_writable(args.out, "weights file")  # before the fit, which takes a while
@@ -100,6 +99,7 @@ def run(args: argparse.Namespace, output_stream=None) -> int:
                             "remaining_time's is 0, so every turn ties with no query); fit with other options "
                             "(e.g. --method trajectory, more "
                             "--iterations), or write them anyway with --allow-degenerate")
+    make_parent(args.out, "weights file")
     with writing(args.out, "weights file"):
         save_weights(args.out, learned.weights, weights_comment(learned))
     for name, value in learned.weights.as_dict().items():

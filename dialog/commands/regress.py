@@ -22,6 +22,7 @@ from dialog.experiments.kinds import RunOptions, get_kind, run_suite
 from dialog.experiments.suite import load_suite, suite_names
 from dialog.output_paths import check_writable, writing
 from dialog.user_weights import named_weights, read_named_weights
+from learning.datafiles import inside
 from learning.errors import SettingsError
 from learning.strategies import STRATEGY_NAMES
 
@@ -85,7 +86,7 @@ def run(args: argparse.Namespace) -> int:
         if args.embodied_costs:
             raise SettingsError("--check compares with the stored baseline, which was made in turns; run "
                                 "--embodied-costs without --check")
-    out = args.results or Path("results") / suite.name
+    out = args.results or inside(Path("results"), Path("results") / suite.name, "results folder")
     check_writable(out, "results", folder=True)
     if args.data_seeds is not None:
         return run_on_data_seeds(args, kind, suite, original, out)

@@ -13,7 +13,7 @@ from dialog.commands._summary import questions_in_words, scene_size, session_tim
 from dialog.commands._viewer import add_viewer_option, hold_viewer, start_viewer, stop_viewer
 from dialog.environment import SimulatedKitchen
 from dialog.experiments.runner import file_label
-from dialog.output_paths import check_writable
+from dialog.output_paths import check_writable, file_argument
 from dialog.session import TEACHERS, SessionSettings, open_session
 from dialog.transcript import read_session
 from dialog.transcript_lock import TranscriptLock
@@ -44,7 +44,7 @@ def register(commands) -> None:
     add_time_options(parser)
     parser.add_argument("--realtime", type=positive_seconds, default=None, metavar="SECONDS",
                         help="real-time mode: each turn lasts SECONDS; a later answer counts as none")
-    parser.add_argument("--transcript", type=Path, default=None,
+    parser.add_argument("--transcript", type=file_argument, default=None,
                         help="transcript path (default runs/teach-<task>-<strategy>-seed<seed>.jsonl, numbered "
                              "if taken)")
     parser.add_argument("--resume", type=Path, default=None, metavar="FILE",

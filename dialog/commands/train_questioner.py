@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import argparse
 import json
-from pathlib import Path
 
 from dialog.commands._arguments import (
     add_kitchen_option,
@@ -18,7 +17,7 @@ from dialog.commands._arguments import (
     price,
     seed,
 )
-from dialog.output_paths import check_writable, writing
+from dialog.output_paths import check_writable, file_argument, make_parent, writing
 from learning.errors import OutputPathError
 
 
@@ -30,7 +29,7 @@ def register(commands) -> None:
                     "data sets. The defaults are the chapter-7 training condition (dialog/suites/ch7-training.toml). "
                     "Writes FILE.toml and FILE.npz; run the policy with --strategy rl:FILE.toml in demo, teach "
                     "and regress.")
-    parser.add_argument("--out", type=Path, required=True, metavar="FILE.toml",
+    parser.add_argument("--out", type=file_argument, required=True, metavar="FILE.toml",
                         help="the policy file to write (its weights go beside it as FILE.npz)")
     parser.add_argument("--steps", type=positive_int, default=20_000, help="environment steps (turns) to train on "
                                                                           "(default 20000)")
@@ -74,6 +73,7 @@ def run(args: argparse.Namespace) -> int:
           f"seed {config.seed}", flush=True)
     policy, summary = train(config, progress=not args.no_progress,
                             provenance={"commit": git_commit(), "price": args.price})
+    make_parent(args.out, "policy file")
     with writing(args.out, "policy file"):
         save_policy(args.out, policy, "written by teachbot train-questioner: a masked PPO questioning policy\n"
                                       "run it with --strategy rl:" + str(args.out))

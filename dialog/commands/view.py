@@ -13,9 +13,9 @@ from __future__ import annotations
 import argparse
 import sys
 import time
-from pathlib import Path
 
 from dialog.commands._arguments import add_scene_options, positive_int, seconds
+from dialog.output_paths import file_argument
 from learning.errors import SettingsError
 
 
@@ -28,9 +28,9 @@ def register(commands) -> None:
     add_scene_options(parser)
     parser.add_argument("--point", type=positive_int, default=None, metavar="N",
                         help="let the arm point at object N and ask about it, as a label question does")
-    parser.add_argument("--export", type=Path, default=None, metavar="HTML",
+    parser.add_argument("--export", type=file_argument, default=None, metavar="HTML",
                         help="write the scene as one static HTML page (opens without a server)")
-    parser.add_argument("--screenshot", type=Path, default=None, metavar="PNG",
+    parser.add_argument("--screenshot", type=file_argument, default=None, metavar="PNG",
                         help="save a picture of the page through headless Chromium (needs chromium and playwright)")
     parser.add_argument("--seconds", type=seconds, default=None,
                         help="keep serving this long, then exit (default: until Ctrl-C, or at once after "
@@ -51,6 +51,8 @@ def run(args: argparse.Namespace) -> int:
     export = None
     if args.export is not None:
         export = check_writable(page_path(args.export, "scene.html"), "scene page")
+    if args.screenshot is not None:
+        check_writable(args.screenshot, "screenshot")
     environment = SimulatedKitchen(task=args.task, kitchen=args.kitchen, seed=args.seed)
     try:
         scene = environment.next_scene(episode_generators(args.seed)["scenes"])

@@ -17,6 +17,7 @@ from dialog.commands._arguments import (
     positive_int,
     seed,
 )
+from dialog.output_paths import check_writable, file_argument, make_parent
 from learning.errors import SettingsError
 
 
@@ -39,7 +40,7 @@ def register(commands) -> None:
     show.add_argument("--stage", type=int, default=None,
                       help="state stage for tasks whose objects change state (default: the first scene's, as "
                            "demo shows it)")
-    show.add_argument("--png", type=Path, default=None, help="also write the annotated camera picture (.png)")
+    show.add_argument("--png", type=file_argument, default=None, help="also write the annotated camera picture (.png)")
     show.set_defaults(handler=run_show)
 
     check = actions.add_parser(
@@ -80,6 +81,8 @@ def run_show(args: argparse.Namespace) -> int:
 
     if args.png is not None and args.png.suffix.lower() != ".png":
         raise SettingsError(f"--png must name a .png file, got '{args.png}'")
+    if args.png is not None:
+        check_writable(args.png, "scene picture")  # before the scene is built
     environment = SimulatedKitchen(task=args.task, kitchen=args.kitchen, seed=args.seed, objects_per_scene=args.objects)
     try:
         rng = episode_generators(args.seed)["scenes"]  # the stream demo and view draw their first scene from
@@ -94,6 +97,7 @@ def run_show(args: argparse.Namespace) -> int:
         if args.png is not None:
             from bullet_world.annotate import annotate, write_png
 
+            make_parent(args.png, "scene picture")
             write_png(args.png, annotate(environment.world.images, scene, environment.world.kitchen))
             print(f"Picture: {args.png}")
     finally:

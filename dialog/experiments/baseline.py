@@ -3,12 +3,15 @@
 from __future__ import annotations
 
 import json
+import sys
 from pathlib import Path
 
 import numpy as np
 
 from dialog.experiments.analysis import CheckpointSummary
 from dialog.experiments.suite import SUITE_DIR, Suite, SuiteError
+from dialog.output_paths import keep_superseded
+from learning.datafiles import inside
 from learning.errors import SettingsError
 from learning.strategies.rl_questioner import PREFIX as RL_PREFIX
 
@@ -17,7 +20,9 @@ DEFAULT_TOLERANCE = 0.05
 
 
 def baseline_path(suite: Suite) -> Path:
-    return BASELINE_DIR / f"{suite.name}.json"
+    """``dialog/suites/baselines/<name>.json``; the suite's name is a file name (no separators), and a link that
+    leads out of the baselines folder is refused."""
+    return inside(BASELINE_DIR, BASELINE_DIR / f"{suite.name}.json", "baseline")
 
 
 def make_baseline(suite: Suite, summaries: list[CheckpointSummary], tolerance: float = DEFAULT_TOLERANCE) -> dict:
@@ -34,19 +39,58 @@ def make_baseline(suite: Suite, summaries: list[CheckpointSummary], tolerance: f
 
 
 def write_baseline(suite: Suite, summaries: list[CheckpointSummary], path: Path | None = None) -> Path:
+    """Store the baseline; one already there is first kept as ``<name>.json.superseded-N`` (said on stderr)."""
     path = path or baseline_path(suite)
     path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(json.dumps(make_baseline(suite, summaries), indent=1) + "\n", encoding="utf-8")
+    text = json.dumps(make_baseline(suite, summaries), indent=1) + "\n"
+    if path.is_file() and path.read_text(encoding="utf-8", errors="replace") != text:
+        kept = keep_superseded(path, "baseline")
+        print(f"the earlier baseline is kept as {kept}", file=sys.stderr, flush=True)
+    path.write_text(text, encoding="utf-8")
     return path
+
+
+def read_baseline(path: Path) -> dict:
+    """A stored baseline, every field checked: ``{"bands": {condition: {strategy: {checkpoint: {"mean": m,
+    "band": [low, high]}}}}, "data_seed": n, ...}``; a damaged one is a SuiteError ``FILE: what (expected ...)``."""
+    def refuse(what: str, expected: str) -> SuiteError:
+        return SuiteError(f"{path}: {what} (expected {expected}); restore it from git or rewrite it with "
+                          "--update-baseline")
+
+    try:
+        stored = json.loads(path.read_bytes().decode("utf-8"))
+    except OSError as error:
+        raise SuiteError(f"{path}: cannot read the baseline ({error.strerror or error})") from None
+    except UnicodeDecodeError as error:
+        raise refuse(f"not UTF-8 text (byte {error.start})", "the JSON teachbot writes") from None
+    except (json.JSONDecodeError, RecursionError) as error:
+        raise refuse(f"not JSON ({getattr(error, 'msg', 'nested too deeply')})", "the JSON teachbot writes") from None
+    if not isinstance(stored, dict) or not isinstance(stored.get("bands"), dict):
+        raise refuse("no 'bands' table", "an object with 'bands': {condition: {strategy: {checkpoint: ...}}}")
+    seed = stored.get("data_seed", 0)
+    if not (isinstance(seed, int) and not isinstance(seed, bool) and seed >= 0):
+        raise refuse(f"'data_seed' is {json.dumps(seed)[:40]}", "a whole number of 0 or more")
+    for condition, strategies in stored["bands"].items():
+        for strategy, checkpoints in (strategies.items() if isinstance(strategies, dict) else [(None, None)]):
+            for checkpoint, entry in (checkpoints.items() if isinstance(checkpoints, dict) else [(None, None)]):
+                where = f"bands.{condition}.{strategy}.{checkpoint}"
+                band = entry.get("band") if isinstance(entry, dict) else None
+                mean = entry.get("mean") if isinstance(entry, dict) else None
+                numbers = [mean, *band] if isinstance(band, list) and len(band) == 2 else []
+                if checkpoint is None or not str(checkpoint).isdigit() or not numbers or not all(
+                        isinstance(v, (int, float)) and not isinstance(v, bool) and np.isfinite(v) for v in numbers) \
+                        or band[0] > band[1]:
+                    raise refuse(f"{where} is {json.dumps(entry)[:60]}",
+                                 "{checkpoint: {\"mean\": m, \"band\": [low, high]}} with finite numbers, low <= high")
+    return stored
 
 
 def refuse_other_data_seed(suite: Suite, path: Path | None = None) -> None:
     """``--check`` compares like with like: a baseline made on data from another seed is refused (SuiteError)."""
     path = path or baseline_path(suite)
-    try:
-        stored = json.loads(path.read_text(encoding="utf-8")).get("data_seed", 0)
-    except (OSError, json.JSONDecodeError, AttributeError):
-        return  # a missing or unreadable baseline is reported by check_against_baseline
+    if not path.exists():
+        return  # a missing baseline is reported by check_against_baseline
+    stored = read_baseline(path).get("data_seed", 0)
     if stored != suite.data_seed:
         raise SuiteError(f"--check: the baseline {path} was made on the data sets of data seed {stored}, this run "
                          f"uses data seed {suite.data_seed}; check with --data-seed {stored}, or run without --check")
@@ -96,12 +140,8 @@ def check_against_baseline(suite: Suite, summaries: list[CheckpointSummary],
     if not path.exists():
         failures.append(f"no stored baseline for suite '{suite.name}' at {path}; run with --update-baseline first")
         return failures
-    try:
-        stored = json.loads(path.read_text(encoding="utf-8"))
-        bands, data_seed = stored["bands"], stored.get("data_seed", 0)
-    except (json.JSONDecodeError, KeyError, AttributeError, TypeError) as error:
-        failures.append(f"baseline {path} is unreadable ({error}); rewrite it with --update-baseline")
-        return failures
+    stored = read_baseline(path)
+    bands, data_seed = stored["bands"], stored.get("data_seed", 0)
     if data_seed != suite.data_seed:
         failures.append(f"baseline {path} was made on data seed {data_seed}, this run on data seed "
                         f"{suite.data_seed}: not comparable")

@@ -10,6 +10,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
+from learning import datafiles
 from learning.actions import DEFAULT_COSTS
 from learning.datafiles import check_keys, integer, number, numbers, read_toml, section, tables, text, texts
 from learning.errors import DataFileError, did_you_mean
@@ -195,7 +196,8 @@ def _suite(table: dict, where: str, known_strategies) -> Suite:
     findings = tuple(_finding(f, kind, strategies, names, f"{where} finding {i + 1}")
                      for i, f in enumerate(tables(table, "finding", where, [])))
     return Suite(
-        name=text(table, "name", where), description=text(table, "description", where, "", nonempty=False),
+        name=datafiles.name(table, "name", where, what="suite name"),
+        description=text(table, "description", where, "", nonempty=False),
         kind=kind, task=text(table, "task", where, "pack-lunchbox"), kitchen=text(table, "kitchen", where, "kitchen-1"),
         strategies=strategies, conditions=conditions, datasets=integer(table, "datasets", where, 5, low=1),
         seeds=numbers(table, "seeds", where, (0,), whole=True, low=0),
@@ -210,7 +212,8 @@ def _suite(table: dict, where: str, known_strategies) -> Suite:
 def _condition(table: dict, where: str, objects_per_scene: int | None = None) -> Condition:
     """One [[condition]]; ``objects_per_scene`` is the suite's scene size, which a condition may override."""
     check_keys(table, where, required=CONDITION_FIELDS, optional=CONDITION_OPTIONAL)
-    return Condition(text(table, "name", where), number(table, "budget", where, low=0.0),
+    return Condition(datafiles.name(table, "name", where, what="condition name"),
+                     number(table, "budget", where, low=0.0),
                      integer(table, "turns", where, low=1), integer(table, "change_every", where, low=1),
                      number(table, "seconds", where, None, above=0.0),
                      integer(table, "objects_per_scene", where, objects_per_scene, low=1),

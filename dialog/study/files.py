@@ -4,23 +4,25 @@
 ``study`` table: study, participant, condition, order, software version);
 ``<order>-<condition>-questionnaire.jsonl`` the answers to the questionnaire after it, and
 ``<order>-<condition>-aborted.json`` the note that the session was aborted, with its reason. A session
-run again with ``--again`` keeps its old files, renamed ``*.superseded-N``.
+run again with ``--again`` keeps its old files, renamed ``*.superseded-N``. Recorded answers are never
+written over: a questionnaire or a note is written only where none is (``write_atomically(...,
+replace=False)``), and a session whose records disagree with each other or with the study file is
+``damaged`` (``dialog.study.records`` reads each kind of record and says what is wrong).
 """
 
 from __future__ import annotations
 
-import json
 import os
 from dataclasses import dataclass
 from pathlib import Path
 
 from dialog import software_version
-from dialog.output_paths import writing
-from dialog.transcript import read_session
-from learning.errors import TranscriptError
+from dialog.output_paths import superseded_name, writing
+from dialog.study.records import expected_session, read_abort_note, read_questionnaire, read_study_transcript
+from learning import datafiles as df
+from learning.errors import OutputPathError, TeachbotError, TranscriptError
 
-STATES = ("missing", "running", "questionnaire", "done", "aborted")
-
+STATES = ("missing", "running", "questionnaire", "done", "aborted", "damaged")
 
 def study_header(study, participant: str, condition: str, order: int) -> dict:
     """What every record of a participant's session names: who, which condition, which position, which software."""
@@ -59,58 +61,83 @@ class SessionFiles:
 
 
 def session_files(study, participant: str, order: int, condition: str) -> SessionFiles:
-    return SessionFiles(study.folder / participant, order, condition)
+    """The session's files, in ``<folder>/<participant>/``; a participant folder that leads out of the study's
+    records folder (a symbolic link) is refused."""
+    df.check_name(participant, "participant id", str(study.path))
+    df.check_name(condition, "condition name", str(study.path))
+    folder = df.inside(study.folder, study.folder / participant, "participant's records")
+    return SessionFiles(folder, order, condition)
 
 
 @dataclass(frozen=True)
 class SessionState:
     state: str  # one of STATES
     turns_done: int = 0
-    reason: str = ""
+    reason: str = ""  # why it was aborted, or what is damaged
 
 
-def read_transcript_checked(files: SessionFiles, expected: dict) -> tuple[dict, list[dict]]:
-    """Header and turns of a session's transcript; one whose study table names another session is refused."""
-    header, records = read_session(files.transcript, tolerate_partial_tail=True)
-    recorded = (header or {}).get("study")
-    if not isinstance(recorded, dict):
-        raise TranscriptError(f"{files.transcript}: line 1: the header has no study table; this file was not "
-                              "written by teachbot study run")
-    for key in ("study", "participant", "condition", "order"):
-        if recorded.get(key) != expected[key]:
-            raise TranscriptError(f"{files.transcript}: line 1: the header's study {key} is "
-                                  f"{json.dumps(recorded.get(key))}, but this file belongs to {key} "
-                                  f"{json.dumps(expected[key])}; was the file moved or renamed?")
-    return header, records
+def read_transcript_checked(files: SessionFiles, expected: dict, session: dict) -> tuple[dict, list[dict]]:
+    """Header and turns of a session's transcript, every field checked (``dialog.study.records``)."""
+    return read_study_transcript(files.transcript, expected, session)
 
 
-def session_state(files: SessionFiles, turns: int, expected: dict, asks_questionnaire: bool) -> SessionState:
-    """The state of one session from its files: missing, running (turns so far), questionnaire, done, aborted."""
+def _has_content(path: Path) -> bool:
+    """True for a transcript with something in it, and for anything that is not a regular file (the reader
+    refuses it by name)."""
+    return path.exists() and (not path.is_file() or path.stat().st_size > 0)
+
+
+def session_state(files: SessionFiles, condition, expected: dict, session: dict, items) -> SessionState:
+    """The state of one session from its files: missing, running (turns so far), questionnaire, done, aborted,
+    or damaged (a record that can't be read, or that disagrees with the study file or with the other records)."""
+    try:
+        return _state(files, condition, expected, session, items)
+    except (TeachbotError, OSError) as error:
+        if isinstance(error, OSError) and not isinstance(error, (PermissionError, IsADirectoryError)):
+            raise
+        return SessionState("damaged", 0, str(error))
+
+
+def _state(files: SessionFiles, condition, expected: dict, session: dict, items) -> SessionState:
+    answered = files.questionnaire.exists()
+    if answered:
+        read_questionnaire(files.questionnaire, expected, items)
     if files.aborted.exists():
-        note = read_json_record(files.aborted, "aborted")
-        return SessionState("aborted", int(note.get("after_turns", 0)), str(note.get("reason", "")))
-    if not files.transcript.exists() or files.transcript.stat().st_size == 0:
+        note = read_abort_note(files.aborted, expected, condition.turns)
+        return SessionState("aborted", note["after_turns"], note["reason"])
+    if not _has_content(files.transcript):
+        if answered:
+            gone = "empty" if files.transcript.exists() else "missing"
+            raise TranscriptError(f"{files.transcript}: the transcript is {gone}, "
+                                  f"but the questionnaire after it is recorded in {files.questionnaire.name}; restore "
+                                  "the transcript, or run the condition again with --condition "
+                                  f"{files.condition} --again (every record is kept, renamed *.superseded-N)")
         return SessionState("missing")
-    _, records = read_transcript_checked(files, expected)
-    if len(records) < turns:
+    _, records = read_transcript_checked(files, expected, session)
+    if len(records) < condition.turns:
         return SessionState("running", len(records))
-    if asks_questionnaire and not files.questionnaire.exists():
+    if items and not answered:
         return SessionState("questionnaire", len(records))
     return SessionState("done", len(records))
 
 
-def read_json_record(path: Path, key: str) -> dict:
+def session_state_of(study, participant: str, position: int, name: str) -> SessionState:
+    """:func:`session_state` of one participant's session at ``position`` (from 1) under condition ``name``."""
+    condition = study.condition(name)
     try:
-        record = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, json.JSONDecodeError) as error:
-        raise TranscriptError(f"{path}: cannot read the study record ({error})") from None
-    if not isinstance(record, dict) or not isinstance(record.get(key), dict):
-        raise TranscriptError(f"{path}: not a teachbot study record (no '{key}' table)")
-    return record[key]
+        files = session_files(study, participant, position, name)
+    except TeachbotError as error:
+        return SessionState("damaged", 0, str(error))
+    return session_state(files, condition, study_header(study, participant, name, position),
+                         expected_session(study, participant, position, condition), study.items)
 
 
-def write_atomically(path: Path, text: str, what: str) -> None:
-    """Write ``text`` to ``path`` through a temporary file and a rename: the record is there whole or not at all."""
+def write_atomically(path: Path, text: str, what: str, *, replace: bool = True) -> None:
+    """Write ``text`` to ``path`` through a temporary file and a rename: the record is there whole or not at all.
+
+    With ``replace=False`` (recorded answers) an existing ``path`` is never written over: the temporary file
+    is linked into place, which fails if the name is taken, and the refusal names the file.
+    """
     temporary = path.with_name(f".{path.name}.tmp")
     with writing(path, what):
         path.parent.mkdir(parents=True, exist_ok=True)
@@ -118,17 +145,24 @@ def write_atomically(path: Path, text: str, what: str) -> None:
             handle.write(text)
             handle.flush()
             os.fsync(handle.fileno())
-        os.replace(temporary, path)
+        if replace:
+            os.replace(temporary, path)
+            return
+        try:
+            os.link(temporary, path)
+        except FileExistsError:
+            raise OutputPathError(f"{path}: already holds the {what}; teachbot never writes over recorded "
+                                  "answers (run the condition again with --condition NAME --again to keep "
+                                  "them as *.superseded-N)") from None
+        finally:
+            os.unlink(temporary)
 
 
 def supersede(files: SessionFiles) -> list[Path]:
     """Rename a session's files ``*.superseded-N`` (kept in the record) so that it can be run again."""
     moved = []
     for path in files.existing():
-        number = 1
-        while path.with_name(f"{path.name}.superseded-{number}").exists():
-            number += 1
-        target = path.with_name(f"{path.name}.superseded-{number}")
+        target = superseded_name(path)
         with writing(path, "superseded session record"):
             path.rename(target)
         moved.append(target)

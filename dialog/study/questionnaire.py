@@ -4,7 +4,8 @@ A Likert item takes a whole number from 1 to its number of points (``skip``
 leaves it unanswered); a free-text item takes any line (empty: unanswered).
 The answers are written together, once all are given, as JSON Lines: a
 ``questionnaire`` header (who, which condition, which position, which software)
-and one line per item.
+and one line per item; never over answers already recorded. They are read
+back by ``dialog.study.records.read_questionnaire``.
 """
 
 from __future__ import annotations
@@ -67,22 +68,7 @@ def ask_simulated(items, rng) -> list[dict]:
 
 
 def save(path, header: dict, answers: list[dict]) -> None:
+    """Write the answers once: a file that already holds answers is never replaced (``OutputPathError``)."""
     lines = [json.dumps({"questionnaire": header}, ensure_ascii=False)]
     lines += [json.dumps(answer, ensure_ascii=False) for answer in answers]
-    write_atomically(path, "\n".join(lines) + "\n", "questionnaire answers")
-
-
-def load(path) -> tuple[dict, list[dict]]:
-    """The header and the answers of a saved questionnaire."""
-    from learning.errors import TranscriptError
-
-    rows = []
-    with open(path, encoding="utf-8") as handle:
-        for number, line in enumerate(handle, start=1):
-            try:
-                rows.append(json.loads(line))
-            except json.JSONDecodeError as error:
-                raise TranscriptError(f"{path}: line {number} is not a JSON record ({error.msg})") from None
-    if not rows or not isinstance(rows[0], dict) or "questionnaire" not in rows[0]:
-        raise TranscriptError(f"{path}: line 1 is not a questionnaire header")
-    return rows[0]["questionnaire"], rows[1:]
+    write_atomically(path, "\n".join(lines) + "\n", "questionnaire answers", replace=False)

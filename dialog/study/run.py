@@ -23,11 +23,12 @@ from dialog.study.design import assigned_orders, questionnaire_rng, session_seed
 from dialog.study.files import (
     read_transcript_checked,
     session_files,
-    session_state,
+    session_state_of,
     study_header,
     supersede,
     write_atomically,
 )
+from dialog.study.records import expected_session
 from dialog.terminal import LineReader
 from dialog.transcript_lock import TranscriptLock
 from learning.errors import OutputPathError, TranscriptError
@@ -75,11 +76,13 @@ class ParticipantRun:
         return self.reader.readline()
 
     def states(self) -> list:
-        asks = bool(self.study.items)
-        return [session_state(session_files(self.study, self.participant, position, name),
-                              self.study.condition(name).turns,
-                              study_header(self.study, self.participant, name, position), asks)
+        return [session_state_of(self.study, self.participant, position, name)
                 for position, name in enumerate(self.order, start=1)]
+
+    def _refuse_damaged(self, position: int, state) -> None:
+        name = self.order[position - 1]
+        raise TranscriptError(f"{self.participant} session {position} ({name}) is damaged, so nothing was written: "
+                              f"{state.reason}")
 
     # -- what to run --------------------------------------------------------------------------------------
     def plan(self, only: str | None, again: bool) -> list[int]:
@@ -89,6 +92,8 @@ class ParticipantRun:
             self.study.condition(only)
             position = self.order.index(only) + 1
             state = states[position - 1]
+            if state.state == "damaged" and not again:
+                self._refuse_damaged(position, state)
             if state.state in ("done", "aborted") and not again:
                 raise TranscriptError(f"{self.participant} already did condition '{only}' ({state.state}); "
                                       f"run it again only with --again (the old records are kept, renamed)")
@@ -105,6 +110,9 @@ class ParticipantRun:
         if again:
             raise TranscriptError("--again needs --condition NAME: the one condition to run again")
         todo = [position for position, state in enumerate(states, start=1) if state.state not in ("done", "aborted")]
+        for position in todo:
+            if states[position - 1].state == "damaged":
+                self._refuse_damaged(position, states[position - 1])
         if not todo:
             raise TranscriptError(f"{self.participant} has already done every session of study '{self.study.name}' "
                                   f"(see teachbot study status); to run one again: --condition NAME --again")
@@ -117,12 +125,15 @@ class ParticipantRun:
         for position, state in enumerate(self.states(), start=1):
             if state.state in ("done", "aborted"):
                 continue
+            if state.state == "damaged":
+                self._refuse_damaged(position, state)
             name = self.order[position - 1]
             files = session_files(self.study, self.participant, position, name)
             note = {**study_header(self.study, self.participant, name, position), "reason": reason.strip(),
                     "after_turns": state.turns_done, "state_before": state.state}
             check_writable(files.aborted, "abort note")
-            write_atomically(files.aborted, json.dumps({"aborted": note}, ensure_ascii=False) + "\n", "abort note")
+            write_atomically(files.aborted, json.dumps({"aborted": note}, ensure_ascii=False) + "\n", "abort note",
+                             replace=False)
             self.write(f"{self.participant}: session {position} ({name}) marked aborted after {state.turns_done} "
                        f"turns: {reason.strip()}")
             return 0
@@ -150,7 +161,9 @@ class ParticipantRun:
         condition = self.study.condition(name)
         files = session_files(self.study, self.participant, position, name)
         settings = condition_settings(self.study, self.participant, position, condition, self.simulated)
-        state = session_state(files, condition.turns, settings.study, bool(self.study.items))
+        state = session_state_of(self.study, self.participant, position, name)
+        if state.state == "damaged":
+            self._refuse_damaged(position, state)
         self.write(f"\n=== Session {position} of {len(self.order)} ({name}) ===")
         if state.state in ("missing", "running"):
             self.write(condition.instructions.strip())
@@ -163,7 +176,10 @@ class ParticipantRun:
             if not finished:
                 self.write(f"Session saved. Continue with: {self.continue_command}")
                 return 130 if finished is None else 0
-        if self.study.items:
+        if self.study.items and files.questionnaire.exists():
+            self.write(f"The questionnaire's answers are already recorded ({files.questionnaire.name}); kept as they "
+                       "are.")
+        elif self.study.items:
             header = settings.study
             if self.simulated:
                 answers = questionnaire.ask_simulated(self.study.items, questionnaire_rng(self.study, self.participant,
@@ -182,7 +198,8 @@ class ParticipantRun:
         lock = TranscriptLock(files.transcript, create=not resume)
         try:
             if resume:
-                read_transcript_checked(files, settings.study)
+                read_transcript_checked(files, settings.study, expected_session(
+                    self.study, self.participant, settings.study["order"], condition))
             elif lock.size() > 0:
                 raise TranscriptError(f"{files.transcript} already holds a session")
             return self._teach(files, settings, condition, resume, lock)

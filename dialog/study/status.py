@@ -5,7 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from dialog.study.design import assigned_orders, balance, williams_rows
-from dialog.study.files import SessionState, session_files, session_state, study_header
+from dialog.study.files import SessionState, session_state_of
 
 
 @dataclass(frozen=True)
@@ -18,15 +18,9 @@ class Cell:
 
 def study_cells(study) -> list[Cell]:
     """One cell per participant and session position, with the state read from the files."""
-    cells = []
-    asks = bool(study.items)
-    for participant, order in assigned_orders(study).items():
-        for position, name in enumerate(order, start=1):
-            files = session_files(study, participant, position, name)
-            state = session_state(files, study.condition(name).turns, study_header(study, participant, name, position),
-                                  asks)
-            cells.append(Cell(participant, position, name, state))
-    return cells
+    return [Cell(participant, position, name, session_state_of(study, participant, position, name))
+            for participant, order in assigned_orders(study).items()
+            for position, name in enumerate(order, start=1)]
 
 
 def _shown(state: SessionState, turns: int) -> str:
@@ -36,6 +30,8 @@ def _shown(state: SessionState, turns: int) -> str:
         return "ABORTED"
     if state.state == "questionnaire":
         return "questionnaire due"
+    if state.state == "damaged":
+        return "DAMAGED"
     return state.state
 
 
@@ -62,12 +58,14 @@ def status_text(study) -> str:
     for participant, row in by_participant.items():
         lines.append((f"{participant:<13}" + "".join(f"{shown[id(c)]:<{width}}" for c in row)).rstrip())
     counts = {state: sum(c.state.state == state for c in cells) for state in
-              ("done", "running", "questionnaire", "aborted", "missing")}
+              ("done", "running", "questionnaire", "aborted", "damaged", "missing")}
     lines.append("sessions: " + ", ".join(f"{count} {state}" for state, count in counts.items()))
     for cell in cells:
         if cell.state.state == "aborted":
             lines.append(f"aborted: {cell.participant} session {cell.position} ({cell.condition}) after "
                          f"{cell.state.turns_done} turns: {cell.state.reason or 'no reason given'}")
+        if cell.state.state == "damaged":
+            lines.append(f"damaged: {cell.participant} session {cell.position} ({cell.condition}): {cell.state.reason}")
     finished = completed_orders(study, cells)
     result = balance(finished, names)
     block = len(williams_rows(len(names))) if study.ordering == "latin" else None

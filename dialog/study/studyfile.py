@@ -2,12 +2,13 @@
 
 Every field goes through ``learning.datafiles``, so a bad study file is refused
 with one line naming the file, the section, the field and what is accepted.
-Participants are known by short ids only (never names): ``P01``, ``lab2-07``.
+Participants are known by short ids only (never names): ``P01``, ``lab2-07``. The study's name, its
+condition names and the participant ids name folders and files, so each must be a name by the one rule
+of ``learning.datafiles.check_name`` (a full match: no separators, no leading dot, no newline).
 """
 
 from __future__ import annotations
 
-import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -19,9 +20,6 @@ from learning.actions import DEFAULT_COSTS
 from learning.errors import DataFileError
 from learning.strategies import STRATEGY_NAMES
 
-ID_PATTERN = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_-]{0,15}$")
-ID_RULE = "1 to 16 letters, digits, '-' or '_', starting with a letter or digit (an id, never a name)"
-NAME_PATTERN = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_-]{0,39}$")
 ORDERINGS = ("latin", "given")
 ITEM_KINDS = ("likert", "text")
 CONDITION_FIELDS = ("name", "instructions", "task", "kitchen", "strategy", "budget", "turns", "change_every",
@@ -29,10 +27,8 @@ CONDITION_FIELDS = ("name", "instructions", "task", "kitchen", "strategy", "budg
 
 
 def check_participant_id(value, where: str = "participant") -> str:
-    """A participant id: short, no spaces or path separators; else a DataFileError saying what is accepted."""
-    if not isinstance(value, str) or not ID_PATTERN.match(value):
-        raise DataFileError(f"{where}: participant id {value!r} is not accepted; an id is {ID_RULE}")
-    return value
+    """A participant id (an id, never a person's name): one folder name by ``learning.datafiles.check_name``."""
+    return df.check_name(value, "participant id", where)
 
 
 @dataclass(frozen=True)
@@ -102,9 +98,7 @@ def load_study(path: str | Path) -> Study:
     df.check_keys(data, where, required=("name", "seed", "conditions"),
                   optional=("folder", "participants", "ids", "order", "orders", "pause", "simulated_teacher",
                             "questionnaire"))
-    name = df.text(data, "name", where)
-    if not NAME_PATTERN.match(name):
-        raise DataFileError(f"{where}: name {name!r} must be 1 to 40 letters, digits, '-' or '_' (it names the folder)")
+    name = df.name(data, "name", where, what="study name")
     seed = df.integer(data, "seed", where, low=0)
     conditions = tuple(_condition(table, f"{where} [[conditions]] {index + 1}")
                        for index, table in enumerate(df.tables(data, "conditions", where, nonempty=True)))
@@ -131,9 +125,7 @@ def load_study(path: str | Path) -> Study:
 
 def _condition(table: dict, where: str) -> Condition:
     df.check_keys(table, where, required=("name", "strategy"), optional=CONDITION_FIELDS)
-    name = df.text(table, "name", where)
-    if not ID_PATTERN.match(name):
-        raise DataFileError(f"{where}: condition name {name!r} must be {ID_RULE.split(' (')[0]} (it names files)")
+    name = df.name(table, "name", where, what="condition name")
     costs = df.section(table, "costs", where, default=dict(DEFAULT_COSTS))
     df.check_keys(costs, f"{where} costs", required=tuple(DEFAULT_COSTS))
     realtime = df.number(table, "realtime", where, default=None, above=0)

@@ -1,15 +1,16 @@
 """The study's records as tidy tables: one row per recorded turn, one per questionnaire answer.
 
 Every session that has a transcript contributes its turns, finished or not
-(``state`` says which); the analysis uses the finished ones.
+(``state`` says which), except a damaged one (its records are not read); the
+analysis uses the finished ones.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
-from dialog.study import questionnaire
 from dialog.study.files import read_transcript_checked, session_files, study_header
+from dialog.study.records import expected_session, read_questionnaire
 from dialog.study.status import Cell, study_cells
 
 TURN_COLUMNS = ("participant", "condition", "order", "simulated", "state", "turn", "action", "cost", "answer",
@@ -49,11 +50,14 @@ def collect(study) -> StudyTables:
     cells = study_cells(study)
     turns, answers = [], []
     for cell in cells:
+        if cell.state.state == "damaged":
+            continue  # listed in the report with what is wrong; its records are not read
         files = session_files(study, cell.participant, cell.position, cell.condition)
         key = {"participant": cell.participant, "condition": cell.condition, "order": cell.position}
+        expected = study_header(study, cell.participant, cell.condition, cell.position)
         if files.transcript.exists() and files.transcript.stat().st_size > 0:
-            header, records = read_transcript_checked(files, study_header(study, cell.participant, cell.condition,
-                                                                          cell.position))
+            session = expected_session(study, cell.participant, cell.position, study.condition(cell.condition))
+            header, records = read_transcript_checked(files, expected, session)
             scripted = (header.get("teacher") or {}).get("kind") == "scripted"
             simulated = recorded_as_simulated(header.get("study", {}), scripted)
             for record in records:
@@ -63,10 +67,9 @@ def collect(study) -> StudyTables:
                               "answer": answer.get("kind", "none"), "answer_seconds": answer.get("seconds", 0.0),
                               "refused": refused_attempts(answer), "accuracy": record.get("accuracy")})
         if files.questionnaire.exists():
-            header, rows = questionnaire.load(files.questionnaire)
-            simulated = recorded_as_simulated(header, any(t["simulated"] for t in turns if t["participant"] ==
-                                                          cell.participant and t["condition"] == cell.condition))
-            for row in rows:
+            simulated = any(t["simulated"] for t in turns  # written by the same run as the session's transcript
+                            if t["participant"] == cell.participant and t["condition"] == cell.condition)
+            for row in read_questionnaire(files.questionnaire, expected, study.items):
                 answers.append({**key, "simulated": simulated, "item": row["item"], "kind": row["kind"],
                                 "value": row["value"]})
     return StudyTables(cells, turns, answers)

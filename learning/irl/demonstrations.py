@@ -301,6 +301,9 @@ def _episodes_from_json(path: Path) -> list[QuestioningEpisode]:
         document = json.loads(path.read_text(encoding="utf-8"))
     except (json.JSONDecodeError, UnicodeDecodeError) as error:
         raise ValueError(f"{path}: not valid JSON ({error})") from None
+    except RecursionError:
+        raise ValueError(f"{path}: not valid JSON for a demonstration file (arrays or objects nested too deeply)") \
+            from None
     if not isinstance(document, dict):
         raise ValueError("expected a JSON object with 'format', 'format_version', 'feature_names' and 'episodes'")
     version_key = _version_field(document)

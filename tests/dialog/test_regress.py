@@ -90,6 +90,40 @@ def test_findings_and_baseline_bands(tmp_path):
     assert "no stored baseline" in check_against_baseline(suite, summaries, tmp_path / "missing.json")[0]
 
 
+def test_a_new_baseline_keeps_the_stored_one_as_superseded(tmp_path, capsys):
+    """Issue 24, item 1: a stored baseline is a record; --update-baseline keeps it, numbered, and says so."""
+    suite = load_suite(write_suite(tmp_path))
+    first = summarise([fake_result("passive", [0.5, 0.7, 0.8, 0.9], [1, 2, 3, 3], d) for d in range(3)], suite)
+    second = summarise([fake_result("passive", [0.4, 0.6, 0.7, 0.8], [1, 2, 3, 3], d) for d in range(3)], suite)
+    path = write_baseline(suite, first, tmp_path / "base.json")
+    stored = path.read_bytes()
+    write_baseline(suite, first, path)  # the same baseline again: nothing to keep
+    assert not list(tmp_path.glob("base.json.superseded-*"))
+    write_baseline(suite, second, path)
+    assert (tmp_path / "base.json.superseded-1").read_bytes() == stored and path.read_bytes() != stored
+    assert f"the earlier baseline is kept as {tmp_path / 'base.json.superseded-1'}" in capsys.readouterr().err
+    write_baseline(suite, first, path)
+    assert (tmp_path / "base.json.superseded-2").is_file()
+
+
+@pytest.mark.parametrize("damage, fragment", [
+    (b"\xff\xfe", "not UTF-8 text"), (b"[" * 100000, "not JSON"), (b"[1, 2, 3]", "no 'bands' table"),
+    (b'{"bands": {"static": {"passive": {"2": {"mean": 0.5, "band": "wide"}}}}}', "bands.static.passive.2 is"),
+    (b'{"bands": {"static": {"passive": {"2": {"mean": 0.5, "band": [0.6, 0.4]}}}}}', "low <= high"),
+    (b'{"bands": {"static": {"passive": {"2": 7}}}}', "bands.static.passive.2 is 7"),
+    (b'{"bands": {}, "data_seed": "zero"}', "'data_seed' is \"zero\""),
+])
+def test_a_damaged_baseline_is_one_line_naming_the_file(tmp_path, damage, fragment):
+    """Issue 24, item 2: the suite results' reader checks every field (no traceback from a band that is a string)."""
+    suite = load_suite(write_suite(tmp_path))
+    summaries = summarise([fake_result("passive", [0.5, 0.7, 0.8, 0.9], [1, 2, 3, 3], d) for d in range(3)], suite)
+    path = tmp_path / "base.json"
+    path.write_bytes(damage)
+    with pytest.raises(SuiteError, match="base.json: ") as refused:
+        check_against_baseline(suite, summaries, path)
+    assert fragment in str(refused.value) and "\n" not in str(refused.value)
+
+
 def test_a_tiny_suite_runs_end_to_end(tmp_path, capsys):
     code = main(["regress", "--suite", str(write_suite(tmp_path)), "--results", str(tmp_path / "out"),
                  "--workers", "1", "--no-progress", "--json"])

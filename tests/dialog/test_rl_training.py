@@ -33,7 +33,7 @@ def test_the_numpy_actor_chooses_what_maskable_ppo_chooses():
 @pytest.fixture(scope="module")
 def trained(tmp_path_factory):
     folder = tmp_path_factory.mktemp("questioner")
-    out = folder / "q.toml"
+    out = folder / "new-folder" / "q.toml"  # a folder that does not exist yet is created (issue 23, case 1)
     assert main(["train-questioner", "--out", str(out), "--steps", "256", "--envs", "1", "--seed", "1",
                  "--no-progress", *TINY]) == 0
     return out

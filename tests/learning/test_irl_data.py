@@ -205,6 +205,9 @@ def test_unreadable_files_are_refused(tmp_path):
     (tmp_path / "bad.json").write_text("{not json")
     with pytest.raises(ValueError, match="not valid JSON"):
         load_episodes(tmp_path / "bad.json")
+    (tmp_path / "deep.json").write_text("[" * 100000)  # found by scripts/fuzz_files.py: a RecursionError before
+    with pytest.raises(ValueError, match="deep.json: not valid JSON for a demonstration file .*nested too deeply"):
+        load_episodes(tmp_path / "deep.json")
     (tmp_path / "demos.csv").write_text("1,2")
     with pytest.raises(ValueError, match="accepted: .json, .npz"):
         load_episodes(tmp_path / "demos.csv")

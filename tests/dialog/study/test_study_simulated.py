@@ -145,9 +145,13 @@ def test_a_transcript_moved_to_another_session_is_refused(folder, tmp_path, caps
     first_text = first.read_text()
     first.write_text(second.read_text())
     second.write_text(first_text)
-    assert study_cli(copy, "status") == 2
+    assert study_cli(copy, "status") == 0  # the study's status is still shown; the two sessions are marked damaged
+    shown = capsys.readouterr().out
+    assert f"damaged: P01 session 1 (dt-task): {first}: line 1: the header's study condition" in shown
+    assert "was it moved, renamed or edited?" in shown and "2 damaged" in shown
+    assert study_cli(copy, "run", "--participant", "P01", "--simulated", "--condition", "dt-task") == 2
     error = capsys.readouterr().err
-    assert str(first) in error and "was the file moved or renamed?" in error
+    assert str(first) in error and "is damaged, so nothing was written" in error and error.count("\n") == 1
 
 
 def test_a_dry_run_goes_to_its_own_folder_and_says_simulated_everywhere(tmp_path, monkeypatch, capsys):

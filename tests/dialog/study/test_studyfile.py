@@ -87,12 +87,13 @@ def test_the_command_line_prints_a_bad_study_as_one_line(tmp_path, capsys):
     assert "does not exist" in capsys.readouterr().err
 
 
-@pytest.mark.parametrize("value", ["P01", "lab2-07", "a_b"])
+@pytest.mark.parametrize("value", ["P01", "lab2-07", "a_b", "P.01", "x" * 64])
 def test_good_participant_ids(value):
     assert check_participant_id(value) == value
 
 
-@pytest.mark.parametrize("value", ["", "Jane Doe", "a/b", "..", "x" * 17, "-P1"])
+@pytest.mark.parametrize("value", ["", "Jane Doe", "a/b", "..", ".P01", "x" * 65, "-P1", "P01\n", "P01\r", "/tmp",
+                                   "P01/", "P\u00e9", "P\x00"])
 def test_participant_ids_are_short_ids_not_names_or_paths(value):
     with pytest.raises(DataFileError, match="not accepted"):
         check_participant_id(value)

@@ -1,0 +1,205 @@
+"""One reader per kind of study record, each checking every field against the study file.
+
+A session's transcript, its questionnaire answers and its abort note are read
+here and nowhere else. A damaged record is refused as ``FILE: line N: what is
+wrong (expected ...)`` (a :class:`~learning.errors.TranscriptError`); ``study
+status`` shows such a session as damaged, ``study report`` leaves it out of the
+analysis and lists it, and ``study run`` refuses to write over it.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+from bullet_world.features import environment_feature_catalogue, object_feature_catalogue, robot_feature_catalogue
+from dialog.records import check_turn_record
+from dialog.transcript import read_numbered_session
+from learning.errors import TranscriptError
+
+#: the session header fields a study's condition fixes, and where the condition keeps each
+CONDITION_HEADER_FIELDS = ("task", "kitchen", "strategy", "turns", "budget", "change_every", "realtime")
+STUDY_KEYS = ("study", "participant", "condition", "order")
+TEXT_LIMIT = 2000  # characters of a free-text answer (the terminal keeps no more)
+
+
+def _shown(value) -> str:
+    text = json.dumps(value, ensure_ascii=False, default=repr)
+    return text if len(text) <= 80 else f"{text[:80]}... ({len(text)} characters)"
+
+
+def _feature_names() -> tuple[str, ...]:
+    catalogue = object_feature_catalogue() + environment_feature_catalogue() + robot_feature_catalogue()
+    return tuple(info.name for info in catalogue)
+
+
+def expected_session(study, participant: str, order: int, condition) -> dict:
+    """The header fields a session of ``condition`` must have been recorded with (its seed from the study seed)."""
+    from dialog.study.design import session_seed
+
+    fields = {name: getattr(condition, name) for name in CONDITION_HEADER_FIELDS}
+    return fields | {"seed": session_seed(study, participant, condition.name)}
+
+
+def _check_study_table(path: Path, recorded, expected: dict, what: str) -> None:
+    if not isinstance(recorded, dict):
+        raise TranscriptError(f"{path}: line 1: the {what} header has no study table (expected the study, participant, "
+                              "condition and order, as teachbot study run writes them)")
+    for key in STUDY_KEYS:
+        if recorded.get(key) != expected[key]:
+            raise TranscriptError(f"{path}: line 1: the header's study {key} is {_shown(recorded.get(key))} (expected "
+                                  f"{_shown(expected[key])}, the {key} this file belongs to; was it moved, renamed or "
+                                  "edited?)")
+
+
+def read_study_transcript(path: Path, expected: dict, session: dict) -> tuple[dict, list[dict]]:
+    """Header and turns of a session's transcript, every field checked; a torn last line (a crash) is left out.
+
+    ``expected`` is the study table (:func:`dialog.study.files.study_header`), ``session`` the fields the
+    condition fixes (:func:`expected_session`): a header that names another participant, condition, order,
+    strategy, seed or number of turns, a duplicated or extra turn and a malformed field are refused by name.
+    """
+    _check_utf8(path)
+    header, numbered = read_numbered_session(path, tolerate_partial_tail=True)
+    if header is None:
+        raise TranscriptError(f"{path}: line 1: no session header (expected the header teachbot study run writes)")
+    _check_study_table(path, header.get("study"), expected, "session")
+    for key, value in session.items():
+        recorded = header.get(key)
+        same = recorded == value and type(recorded) is not bool
+        if isinstance(value, float) and isinstance(recorded, (int, float)) and not isinstance(recorded, bool):
+            same = math.isclose(recorded, value, rel_tol=0, abs_tol=1e-12)
+        if not same:
+            raise TranscriptError(f"{path}: line 1: the session header's '{key}' is {_shown(recorded)} (expected "
+                                  f"{_shown(value)}, as the study file sets it for this session)")
+    concepts = header.get("concepts")
+    if not (isinstance(concepts, list) and concepts and all(isinstance(c, str) for c in concepts)):
+        raise TranscriptError(f"{path}: line 1: the session header's 'concepts' is {_shown(concepts)} (expected the "
+                              "list of the task's concept names)")
+    names = _feature_names()
+    records = []
+    for turn, (line, record) in enumerate(numbered, start=1):
+        try:
+            check_turn_record(record, turn, session["turns"], concepts, names)
+            accuracy = record.get("accuracy")
+            if accuracy is not None and not (isinstance(accuracy, (int, float)) and not isinstance(accuracy, bool)
+                                             and 0 <= accuracy <= 1):
+                raise TranscriptError(f"'accuracy' is {_shown(accuracy)} (expected a held-out accuracy from 0 to 1)")
+        except TranscriptError as error:
+            raise TranscriptError(f"{path}: line {line}: {error}") from None
+        records.append(record)
+    return header, records
+
+
+def _regular(path: Path, what: str) -> None:
+    """Refuse a record that is a folder, a FIFO or a device before opening it (reading a FIFO would block)."""
+    if path.exists() and not path.is_file():
+        raise TranscriptError(f"{path}: not a regular file (expected the {what} teachbot study run wrote)")
+
+
+def _check_utf8(path: Path) -> None:
+    """Refuse bytes that are not UTF-8 in the complete lines of a record (a torn last line is left to the resume)."""
+    _regular(path, "transcript")
+    try:
+        raw = path.read_bytes()
+    except OSError as error:
+        raise TranscriptError(f"{path}: cannot read the transcript ({error.strerror or error})") from None
+    complete = raw[:raw.rfind(b"\n") + 1]
+    try:
+        complete.decode("utf-8")
+    except UnicodeDecodeError as error:
+        line = complete[:error.start].count(b"\n") + 1
+        raise TranscriptError(f"{path}: line {line}: not UTF-8 text (byte {error.start}; expected the JSON Lines "
+                              "teachbot writes)") from None
+
+
+def _json_lines(path: Path, what: str) -> list[tuple[int, object]]:
+    _regular(path, what)
+    try:
+        raw = path.read_bytes()
+    except OSError as error:
+        raise TranscriptError(f"{path}: cannot read the {what} ({error.strerror or error})") from None
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as error:
+        line = raw[:error.start].count(b"\n") + 1
+        raise TranscriptError(f"{path}: line {line}: not UTF-8 text (byte {error.start}; expected the JSON Lines "
+                              f"teachbot writes)") from None
+    rows = []
+    for number, line in enumerate(text.splitlines(), start=1):
+        if not line.strip():
+            continue
+        try:
+            rows.append((number, json.loads(line)))
+        except json.JSONDecodeError as error:
+            raise TranscriptError(f"{path}: line {number}: not a JSON record ({error.msg}; expected one JSON object "
+                                  "per line)") from None
+        except RecursionError:
+            raise TranscriptError(f"{path}: line {number}: nests JSON too deeply (expected one flat record)") from None
+    return rows
+
+
+def read_questionnaire(path: Path, expected: dict, items) -> list[dict]:
+    """The answers of a saved questionnaire, each checked: one line per item of the study, in its order, with a
+    value the item accepts (a whole number 1..points or null; text or null), under a header naming this session."""
+    rows = _json_lines(path, "questionnaire answers")
+    if not rows or not isinstance(rows[0][1], dict) or set(rows[0][1]) != {"questionnaire"}:
+        raise TranscriptError(f"{path}: line {rows[0][0] if rows else 1}: not a questionnaire header (expected "
+                              "{\"questionnaire\": {study, participant, condition, order, software}})")
+    _check_study_table(path, rows[0][1]["questionnaire"], expected, "questionnaire")
+    by_id = {item.id: item for item in items}
+    seen: dict[str, int] = {}
+    answers = []
+    for number, row in rows[1:]:
+        where = f"{path}: line {number}"
+        if not isinstance(row, dict) or set(row) != {"item", "kind", "value"}:
+            raise TranscriptError(f"{where}: {_shown(row)} is not an answer (expected {{\"item\", \"kind\", "
+                                  "\"value\"}})")
+        item = by_id.get(row["item"]) if isinstance(row["item"], str) else None
+        if item is None:
+            raise TranscriptError(f"{where}: item {_shown(row['item'])} is not in the study's questionnaire "
+                                  f"(expected one of {', '.join(by_id) or 'none'})")
+        if row["item"] in seen:
+            raise TranscriptError(f"{where}: item '{item.id}' is answered twice (first on line {seen[item.id]}; "
+                                  "expected one answer per item)")
+        seen[item.id] = number
+        if row["kind"] != item.kind:
+            raise TranscriptError(f"{where}: item '{item.id}' has kind {_shown(row['kind'])} (expected "
+                                  f"'{item.kind}', as the study file says)")
+        value = row["value"]
+        if item.kind == "likert" and value is not None and not (
+                isinstance(value, int) and not isinstance(value, bool) and 1 <= value <= item.points):
+            raise TranscriptError(f"{where}: item '{item.id}' has value {_shown(value)} (expected a whole number "
+                                  f"from 1 to {item.points}, or null for skipped)")
+        if item.kind == "text" and value is not None and not (isinstance(value, str) and len(value) <= TEXT_LIMIT):
+            raise TranscriptError(f"{where}: item '{item.id}' has value {_shown(value)} (expected text of at most "
+                                  f"{TEXT_LIMIT} characters, or null for left out)")
+        answers.append(row)
+    missing = [item.id for item in items if item.id not in seen]
+    if missing:
+        raise TranscriptError(f"{path}: no answer for item '{missing[0]}' (expected one line for each of "
+                              f"{', '.join(by_id)})")
+    if [row["item"] for row in answers] != [item.id for item in items]:
+        raise TranscriptError(f"{path}: the answers are not in the questionnaire's order (expected "
+                              f"{', '.join(by_id)})")
+    return answers
+
+
+def read_abort_note(path: Path, expected: dict, turns: int) -> dict:
+    """The note of an aborted session: its study table, a reason, the turns done before (0..turns)."""
+    rows = _json_lines(path, "abort note")
+    if len(rows) != 1 or not isinstance(rows[0][1], dict) or set(rows[0][1]) != {"aborted"} \
+            or not isinstance(rows[0][1]["aborted"], dict):
+        raise TranscriptError(f"{path}: line {rows[0][0] if rows else 1}: not an abort note (expected one line "
+                              "{\"aborted\": {study, participant, condition, order, reason, after_turns, ...}})")
+    note = rows[0][1]["aborted"]
+    _check_study_table(path, note, expected, "abort note")
+    after = note.get("after_turns")
+    if not (isinstance(after, int) and not isinstance(after, bool) and 0 <= after <= turns):
+        raise TranscriptError(f"{path}: line 1: 'after_turns' is {_shown(after)} (expected a whole number from 0 to "
+                              f"{turns}, the turns done before the abort)")
+    if not (isinstance(note.get("reason"), str) and note["reason"].strip()):
+        raise TranscriptError(f"{path}: line 1: 'reason' is {_shown(note.get('reason'))} (expected the reason given "
+                              "with --abort)")
+    return note
