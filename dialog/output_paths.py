@@ -75,10 +75,21 @@ def check_writable(path: str | Path, what: str, *, folder: bool = False) -> Path
         if _read_only(target):
             return _refuse(path, what, errno.EROFS, f"{target} is on a read-only file system (EROFS)")
         return _refuse(path, what, errno.EACCES, f"no permission to write {target} (EACCES)")
+    if _holds_no_files(ancestor):
+        return _refuse(path, what, errno.EACCES, f"{ancestor} is on a virtual file system of the kernel (such as "
+                                                 "/proc or /sys), which holds no files; give a path on a disk")
     free = _free_bytes(ancestor)
     if free == 0:
         return _refuse(path, what, errno.ENOSPC)
     return path
+
+
+def _holds_no_files(folder: Path) -> bool:
+    """True on a file system with no storage at all (procfs, sysfs: zero blocks), which statvfs reports as full."""
+    try:
+        return os.statvfs(folder).f_blocks == 0
+    except (OSError, AttributeError):
+        return False
 
 
 def _refuse(path: Path, what: str, code: int, detail: str = "") -> Path:
