@@ -20,7 +20,8 @@ from learning.errors import SettingsError, TeachbotError
 __all__ = ["LIMITS_FILE", "Limit", "check_limit", "limit", "maximum"]
 
 LIMITS_FILE = Path(__file__).resolve().parent / "data" / "limits.toml"
-NAMES = ("turns", "seconds", "realtime", "budget", "datasets", "seeds", "concepts", "scene_objects", "checkpoints")
+NAMES = ("turns", "seconds", "realtime", "budget", "datasets", "seeds", "concepts", "scene_objects", "checkpoints",
+         "weight")
 
 
 @dataclass(frozen=True)
