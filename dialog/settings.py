@@ -15,7 +15,7 @@ from numbers import Integral, Real
 
 from learning.actions import DEFAULT_COSTS
 from learning.errors import SettingsError
-from learning.limits import check_limit
+from learning.limits import check_limit, check_questions
 
 __all__ = ["DEFAULTS", "EpisodeSettings", "check_allocation", "check_costs"]
 
@@ -86,6 +86,7 @@ class EpisodeSettings:
         if not isinstance(self.fetch_from_pantry, bool):
             raise SettingsError(f"fetch_from_pantry must be true or false, got {self.fetch_from_pantry!r}")
         check_costs(self.costs)
+        check_questions(self.turns, self.budget, self.costs)
         if self.weights is not None:
             from dialog.user_weights import weights_from_record
 

@@ -17,11 +17,11 @@ from pathlib import Path
 from learning.datafiles import check_keys, number, read_toml, text
 from learning.errors import SettingsError, TeachbotError
 
-__all__ = ["LIMITS_FILE", "Limit", "check_limit", "limit", "maximum"]
+__all__ = ["LIMITS_FILE", "Limit", "check_limit", "check_questions", "limit", "maximum"]
 
 LIMITS_FILE = Path(__file__).resolve().parent / "data" / "limits.toml"
-NAMES = ("turns", "seconds", "realtime", "budget", "datasets", "seeds", "concepts", "scene_objects", "checkpoints",
-         "weight")
+NAMES = ("turns", "questions", "seconds", "realtime", "budget", "datasets", "seeds", "concepts", "scene_objects",
+         "checkpoints", "weight")
 
 
 @dataclass(frozen=True)
@@ -65,3 +65,17 @@ def check_limit(name: str, value, label: str | None = None, error: type[Teachbot
     found = limit(name)
     if value > found.maximum:
         raise error(found.refusal(label or name, value))
+
+
+def check_questions(turns: int, budget: float, costs: dict) -> None:
+    """Refuse an episode that could pay for more questions than the limit: each answered question adds an
+    example that every later turn refits on (GP fits grow with the cube of the examples), whereas a quiet turn
+    costs little, so the limit is on min(turns, budget / the cheapest question), not on turns alone."""
+    prices = [float(cost) for kind, cost in costs.items() if kind != "none"]
+    cheapest = min(prices) if prices else 0.0
+    questions = turns if cheapest <= 0 else min(turns, int(budget // cheapest))
+    found = limit("questions")
+    if questions > found.maximum:
+        raise SettingsError(f"questions: {turns} turns with a budget of {budget:g} can pay for {questions} questions, "
+                            f"beyond the limit of {found.maximum:g} questions in one episode "
+                            "(learning/data/limits.toml); give fewer turns or a smaller budget")

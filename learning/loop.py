@@ -20,7 +20,7 @@ from learning.answers import AnswerError, Change
 from learning.classifier import ConceptClassifier
 from learning.concepts import checked_rows, normalise_rows
 from learning.errors import SettingsError, TeachbotError
-from learning.limits import check_limit
+from learning.limits import check_limit, check_questions
 from learning.state import LearningState
 from learning.strategies import Strategy, make_strategy
 
@@ -74,6 +74,8 @@ class TeachingLoop:
             if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
                 raise SettingsError(f"{name} must be a whole number >= 1, got {value!r}")
         self.costs = validate_costs({"none": 0, **(DEFAULT_COSTS if costs is None else costs)})
+        check_limit("turns", turns)
+        check_questions(int(turns), float(budget), self.costs)
         self.budget, self.turns, self.change_every = float(budget), int(turns), int(change_every)
         self.rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
         self.feature_names = None if feature_names is None else tuple(str(n) for n in feature_names)

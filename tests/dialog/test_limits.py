@@ -79,6 +79,7 @@ def _one_line(capsys, *argv) -> str:
     (["demo", "--budget", "1e300"], "budget: 1e+300 is beyond the limit of 1e+06 cost units"),
     (["teach", "--realtime", "1e300"], "realtime: 1e+300 is beyond the limit of 3600 seconds per turn"),
     (["regress", "--suite", "smoke", "--datasets", "1000000"], "--datasets: 1000000 is beyond the limit of 100"),
+    (["demo", "--turns", "10000", "--budget", "1e6"], "can pay for 10000 questions, beyond the limit of 2000"),
 ])
 def test_a_run_beyond_a_limit_is_refused_before_it_starts(capsys, argv, expected):
     line = _one_line(capsys, *argv)

@@ -335,3 +335,11 @@ def test_more_concepts_or_scene_objects_than_the_limits_are_refused_before_any_w
     loop = TeachingLoop([0, 1], feature_names=NAMES)
     refused(loop, lambda: loop.observe(np.zeros((maximum("scene_objects") + 1, 4))), SettingsError,
             "objects .rows. in scene 0: 257 is beyond the limit of 256")
+
+
+def test_an_episode_longer_or_with_more_questions_than_the_limits_is_refused():
+    with pytest.raises(SettingsError, match="turns: 100000000 is beyond the limit of 10000"):
+        TeachingLoop([0, 1], turns=100_000_000)
+    with pytest.raises(SettingsError, match="can pay for 5000 questions, beyond the limit of 2000"):
+        TeachingLoop([0, 1], turns=5000, budget=1e6)
+    TeachingLoop([0, 1], turns=5000, budget=40)  # quiet turns are cheap: 40 questions at most
