@@ -173,5 +173,5 @@ def test_a_task_with_too_many_concepts_is_refused(tmp_path):
     names = [f"c{i}" for i in range(maximum("concepts") + 1)]
     path = tmp_path / "big.toml"
     path.write_text(f'name = "big"\nconcepts = {names}\nobjects = "x"\nobjects_per_scene = 70\ntest_scenes = 1\n')
-    with pytest.raises(DataFileError, match="65 concepts are beyond the limit of 64"):
+    with pytest.raises(DataFileError, match="33 concepts are beyond the limit of 32"):
         load_task(path)

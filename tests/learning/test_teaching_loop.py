@@ -330,11 +330,11 @@ def test_none_nan_and_complex_concepts_are_refused(concepts):
 def test_more_concepts_or_scene_objects_than_the_limits_are_refused_before_any_work():
     from learning.limits import maximum
 
-    with pytest.raises(SettingsError, match="concepts: 10000 is beyond the limit of 64"):
+    with pytest.raises(SettingsError, match="concepts: 10000 is beyond the limit of 32"):
         TeachingLoop([str(i) for i in range(10_000)], strategy="dt-task")  # tried to allocate 107 GiB
     loop = TeachingLoop([0, 1], feature_names=NAMES)
     refused(loop, lambda: loop.observe(np.zeros((maximum("scene_objects") + 1, 4))), SettingsError,
-            "objects .rows. in scene 0: 257 is beyond the limit of 256")
+            "objects .rows. in scene 0: 129 is beyond the limit of 128")
 
 
 def test_an_episode_longer_or_with_more_questions_than_the_limits_is_refused():
