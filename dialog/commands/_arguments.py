@@ -147,6 +147,7 @@ def _whole_number(example: str):
 seed = _whole_number("give a seed of 0 or more, e.g. --seed 0")
 seeds = _whole_number("give one or more seeds, e.g. --seeds 0 1 2")
 data_seed = _whole_number("give the seed the data sets are rendered from, 0 or more, e.g. --data-seed 1")
+stage = _whole_number("give a state stage of 0 or more, e.g. --stage 1")
 
 
 def task_names() -> list[str]:

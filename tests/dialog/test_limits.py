@@ -175,3 +175,15 @@ def test_a_task_with_too_many_concepts_is_refused(tmp_path):
     path.write_text(f'name = "big"\nconcepts = {names}\nobjects = "x"\nobjects_per_scene = 70\ntest_scenes = 1\n')
     with pytest.raises(DataFileError, match="33 concepts are beyond the limit of 32"):
         load_task(path)
+
+
+def test_no_command_line_number_is_read_by_plain_int_or_float():
+    """Every number option goes through the ASCII-digit types of dialog/commands/_arguments.py."""
+    import argparse
+
+    from tests.dialog.test_cli_arguments import ALL_PARSERS
+
+    for path, parser in ALL_PARSERS:
+        for action in parser._actions:
+            if not isinstance(action, argparse._SubParsersAction):
+                assert action.type not in (int, float), f"{' '.join(path)} {action.option_strings}: type={action.type}"
