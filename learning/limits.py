@@ -21,7 +21,7 @@ __all__ = ["LIMITS_FILE", "Limit", "check_limit", "check_questions", "limit", "m
 
 LIMITS_FILE = Path(__file__).resolve().parent / "data" / "limits.toml"
 NAMES = ("turns", "questions", "seconds", "realtime", "budget", "datasets", "seeds", "concepts", "scene_objects",
-         "checkpoints", "weight")
+         "checkpoints", "training_steps", "workers", "weight")
 
 
 @dataclass(frozen=True)

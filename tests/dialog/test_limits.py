@@ -80,8 +80,12 @@ def _one_line(capsys, *argv) -> str:
     (["teach", "--realtime", "1e300"], "realtime: 1e+300 is beyond the limit of 3600 seconds per turn"),
     (["regress", "--suite", "smoke", "--datasets", "1000000"], "--datasets: 1000000 is beyond the limit of 100"),
     (["demo", "--turns", "10000", "--budget", "1e6"], "can pay for 10000 questions, beyond the limit of 2000"),
+    (["train-questioner", "--out", "q.toml", "--steps", "1000000000"], "steps: 1000000000 is beyond the limit"),
+    (["train-questioner", "--out", "q.toml", "--envs", "1000"], "envs: 1000 is beyond the limit of 32 worker"),
+    (["regress", "--suite", "smoke", "--workers", "100000"], "--workers: 100000 is beyond the limit of 32 worker"),
 ])
-def test_a_run_beyond_a_limit_is_refused_before_it_starts(capsys, argv, expected):
+def test_a_run_beyond_a_limit_is_refused_before_it_starts(capsys, argv, expected, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
     line = _one_line(capsys, *argv)
     assert expected in line and "learning/data/limits.toml" in line, line
 
