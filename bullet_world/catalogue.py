@@ -16,6 +16,7 @@ import numpy as np
 from bullet_world.datafiles import DATA_DIR, DataFileError, colour_list, read_toml, resolve
 from bullet_world.kitchen import INTEREST_POINTS, Kitchen, Location, load_kitchen
 from learning.datafiles import check_keys, flag, integer, number, numbers, section, tables, text, texts, value_range
+from learning.limits import maximum
 
 __all__ = ["DATA_DIR", "SHAPES", "DataFileError", "Kitchen", "KindState", "Location", "ObjectKind", "Task",
            "load_kitchen", "load_object_kinds", "load_task"]
@@ -211,9 +212,11 @@ class Task:
 def _dataset_plan(table: dict, where: str, default_objects: int) -> DatasetPlan:
     check_keys(table, where, optional=("pools", "pool_size", "test_size", "objects_per_scene"))
     return DatasetPlan(
-        pools=integer(table, "pools", where, 5, low=1), pool_size=integer(table, "pool_size", where, 400, low=1),
+        pools=integer(table, "pools", where, 5, low=1, high=maximum("datasets")),
+        pool_size=integer(table, "pool_size", where, 400, low=1),
         test_size=integer(table, "test_size", where, 200, low=1),
-        objects_per_scene=integer(table, "objects_per_scene", where, default_objects, low=1),
+        objects_per_scene=integer(table, "objects_per_scene", where, default_objects, low=1,
+                                  high=maximum("scene_objects")),
     )
 
 
@@ -225,6 +228,9 @@ def load_task(name_or_path: str | Path) -> Task:
     check_keys(table, where, required=("name", "concepts", "objects", "objects_per_scene", "test_scenes"),
                optional=TASK_FIELDS)
     concepts = texts(table, "concepts", where, nonempty=True)
+    if len(concepts) > maximum("concepts"):
+        raise DataFileError(f"{where}: {len(concepts)} concepts are beyond the limit of {maximum('concepts')} "
+                            "concepts a learner tells apart (learning/data/limits.toml)")
     if len(set(concepts)) != len(concepts):
         raise DataFileError(f"{where}: 'concepts' must not repeat a name, got {list(concepts)}")
     objects_path = resolve("objects", text(table, "objects", where))
@@ -235,8 +241,8 @@ def load_task(name_or_path: str | Path) -> Task:
     uncovered = sorted(set(concepts) - {k.concept for k in kinds})
     if uncovered:
         raise DataFileError(f"{where}: no object kind for concepts {uncovered}")
-    count = integer(table, "objects_per_scene", where, low=len(concepts))
-    largest = integer(table, "max_objects_per_scene", where, count, low=count)
+    count = integer(table, "objects_per_scene", where, low=len(concepts), high=maximum("scene_objects"))
+    largest = integer(table, "max_objects_per_scene", where, count, low=count, high=maximum("scene_objects"))
     placement = text(table, "placement", where, "anywhere", choices=("anywhere", "locations"))
     probability = number(table, "state_change_probability", where, 0.0, low=0.0, high=1.0)
     task = Task(

@@ -27,13 +27,18 @@ The defaults are the thesis's chapter-7 training condition, read from
 dialog/suites/ch7-training.toml (prepare-lunch, budget 15, 30 turns, a new
 scene every 10 turns, costs DQ 2, FSQ 2, LQ 1, data seed 100), so a policy
 trained on them has seen none of the data the chapter-7 suite reports on.
-``reset(seed=s)`` plays data set ``s mod datasets`` with episode seed ``s``:
-the same seed and actions give the same episode.
+``reset(seed=s)`` plays data set ``s mod datasets`` with episode seed ``s``
+(``options={"dataset": k}`` plays data set k instead; any other option is
+refused): the same seed and actions give the same episode. Every argument is
+checked when given (docs/rl.md): an action outside ``action_space`` (``1.7``,
+``"0"``, ``True``) raises :class:`InvalidActionError`, an AssertionError as in
+Gymnasium's own environments, and a one-line SettingsError.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from os import PathLike
 
 import gymnasium as gym
 import numpy as np
@@ -42,12 +47,14 @@ from gymnasium import spaces
 from dialog.experiments.episodes import suite_teacher
 from dialog.experiments.irl_rollouts import training_condition
 from dialog.experiments.pools import PoolEnvironment, load_pools
+from dialog.experiments.suite import teacher_options
 from dialog.manager import DialogManager, episode_generators
 from dialog.settings import EpisodeSettings, check_costs
 from dialog.transcript import MemoryTranscript, TranscriptWriter
 from learning.actions import NoQuery
 from learning.decision.features import FEATURE_NAMES
 from learning.errors import SettingsError
+from learning.limits import check_limit
 from learning.rl.observation import Observation, ObservationLayout
 from learning.state import LearningState
 from learning.strategies.base import Strategy
@@ -55,6 +62,12 @@ from learning.whatif import make_engine
 
 ENV_ID = "teachbot/Questioning-v0"
 SEED_LIMIT = 2**31  # episode seeds drawn when reset() gets none
+RESET_OPTIONS = ("dataset",)  # reset(options=...): the keys accepted
+
+
+class InvalidActionError(SettingsError, AssertionError):
+    """An action outside the action space. Gymnasium's own environments assert
+    ``action_space.contains(action)``, so this is an AssertionError too (and a one-line TeachbotError)."""
 
 
 class AgentChooses(Strategy):
@@ -89,6 +102,14 @@ class QuestioningSettings:
         given = {name: value for name, value in self.__dict__.items() if value is not None}
         settings = replace(filled, **given)
         check_costs(settings.costs)
+        if not isinstance(settings.teacher, dict):
+            raise SettingsError(f"teacher must be a dict of teacher options, got {settings.teacher!r}")
+        teacher_options(settings.teacher, "teacher")
+        for name in ("datasets", "data_seed"):
+            value, low = getattr(settings, name), 1 if name == "datasets" else 0
+            if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < low:
+                raise SettingsError(f"{name} must be a whole number of {low} or more, got {value!r}")
+        check_limit("datasets", settings.datasets)
         EpisodeSettings(task=settings.task, kitchen=settings.kitchen, turns=settings.turns, budget=settings.budget,
                         change_every=settings.change_every, costs=dict(settings.costs))  # validates the allocation
         return settings
@@ -106,6 +127,11 @@ class QuestioningEnv(gym.Env):
                  render_mode: str | None = None):
         self.settings = QuestioningSettings(task, kitchen, budget, turns, change_every, costs, teacher, data_seed,
                                             datasets).resolved()
+        if not isinstance(whatif, bool | np.bool_):
+            raise SettingsError(f"whatif must be True or False (each slot's expected features in the observation), "
+                                f"got {whatif!r}")
+        if transcript is not None and not isinstance(transcript, str | PathLike):
+            raise SettingsError(f"transcript must be None or a path, got {transcript!r}")
         if not isinstance(price, int | float) or isinstance(price, bool) or not np.isfinite(price) or price < 0:
             raise SettingsError(f"price must be a number of 0 or more (reward lost per unit of budget), got {price!r}")
         if render_mode not in (None, *self.metadata["render_modes"]):
@@ -129,16 +155,17 @@ class QuestioningEnv(gym.Env):
 
     # -- Gymnasium ------------------------------------------------------------------------
     def reset(self, *, seed: int | None = None, options: dict | None = None):
+        if seed is not None and (isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0):
+            raise SettingsError(f"seed must be None or a whole number of 0 or more, got {seed!r}")
+        dataset = self._dataset_option(options)  # checked before anything changes
         super().reset(seed=seed)
         self.close()
         if seed is None:
             seed = int(self.np_random.integers(SEED_LIMIT))
-        if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0:
-            raise SettingsError(f"seed must be a whole number of 0 or more, got {seed!r}")
         s = self.settings
         self.episode_seed = int(seed)
         scenes = -(-s.turns // s.change_every)
-        dataset = self.episode_seed % s.datasets
+        dataset = self.episode_seed % s.datasets if dataset is None else dataset
         world = PoolEnvironment(self.pools.train[dataset], self.pools.test, self.pools.task, scenes)
         rngs = episode_generators(self.episode_seed)
         config = EpisodeSettings(task=s.task, kitchen=s.kitchen, strategy=AgentChooses.name, seed=self.episode_seed,
@@ -158,9 +185,11 @@ class QuestioningEnv(gym.Env):
         manager, observation = self._running()
         if self._ended:
             raise SettingsError("the episode ended at its time allocation; call reset() to start another")
+        if isinstance(action, bool | np.bool_) or not self.action_space.contains(action):
+            raise InvalidActionError(f"action {action!r} ({type(action).__name__}) is not a slot "
+                                     f"0..{self.layout.n_actions - 1} of the action space {self.action_space} (an int "
+                                     "or a numpy integer, as Discrete.contains accepts; not a bool, float or string)")
         slot = int(action)
-        if not 0 <= slot < self.layout.n_actions:
-            raise SettingsError(f"action {action!r} is not a slot 0..{self.layout.n_actions - 1}")
         chosen = observation.actions[slot]
         invalid = chosen is None
         record = manager.realise(NoQuery() if chosen is None else chosen,
@@ -195,6 +224,20 @@ class QuestioningEnv(gym.Env):
             self.manager = None
 
     # -- the episode ----------------------------------------------------------------------
+    def _dataset_option(self, options) -> int | None:
+        """``reset(options={"dataset": k})`` plays training data set k (default: the seed mod datasets)."""
+        if options is None:
+            return None
+        if not isinstance(options, dict) or set(options) - set(RESET_OPTIONS):
+            raise SettingsError(f"reset options must be a dict with the keys {', '.join(RESET_OPTIONS)} (or None), "
+                                f"got {options!r}")
+        dataset = options.get("dataset")
+        if dataset is not None and (isinstance(dataset, bool) or not isinstance(dataset, int | np.integer)
+                                    or not 0 <= dataset < self.settings.datasets):
+            raise SettingsError(f"reset option 'dataset' must be a whole number 0..{self.settings.datasets - 1} "
+                                f"(the environment's training data sets), got {dataset!r}")
+        return None if dataset is None else int(dataset)
+
     @property
     def records(self) -> list[dict]:
         """This episode's transcript records so far (the header first) when it is kept in memory."""

@@ -15,28 +15,42 @@ from numbers import Integral, Real
 
 from learning.actions import DEFAULT_COSTS
 from learning.errors import SettingsError
+from learning.limits import check_limit, check_questions
 
 __all__ = ["DEFAULTS", "EpisodeSettings", "check_allocation", "check_costs"]
 
 
 def check_allocation(turns, budget, change_every, realtime=None, seed=0, seconds=None) -> None:
     """T turns, budget B, a change every r turns, seconds per turn (None: turn-based), the seed and an embodied
-    allocation in seconds (None: time in turns), or SettingsError."""
+    allocation in seconds (None: time in turns), or SettingsError; each within its limit (learning/limits.py)."""
     if not _is_int(turns) or turns < 1:
-        raise SettingsError(f"turns must be at least 1, got {turns}")
-    if not (isinstance(budget, Real) and not isinstance(budget, bool) and budget >= 0):
-        raise SettingsError(f"budget must be zero or more, got {budget}")
+        raise SettingsError(f"turns must be at least 1 (a whole number), got {_shown(turns)}")
+    check_limit("turns", turns)
+    if not (_is_number(budget) and budget >= 0):
+        raise SettingsError(f"budget must be a number of zero or more cost units, got {_shown(budget)}")
+    check_limit("budget", budget)
     if not _is_int(change_every) or change_every < 1:
-        raise SettingsError(f"change-every must be at least 1 turn, got {change_every}")
+        raise SettingsError(f"change-every must be at least 1 turn (a whole number), got {_shown(change_every)}")
     if realtime is not None and not (_is_number(realtime) and realtime > 0):
-        raise SettingsError(f"realtime must be a positive number of seconds per turn, got {realtime}")
+        raise SettingsError(f"realtime must be a positive number of seconds per turn, got {_shown(realtime)}")
+    if realtime is not None:
+        check_limit("realtime", realtime)
     if not _is_int(seed) or seed < 0:
-        raise SettingsError(f"seed must be a whole number of 0 or more, got {seed}")
+        raise SettingsError(f"seed must be a whole number of 0 or more, got {_shown(seed)}")
     if seconds is not None and not (_is_number(seconds) and seconds > 0):
-        raise SettingsError(f"the time allocation in seconds must be a positive number, got {seconds}")
+        raise SettingsError(f"the time allocation in seconds must be a positive number, got {_shown(seconds)}")
+    if seconds is not None:
+        check_limit("seconds", seconds, "the time allocation in seconds")
     if seconds is not None and realtime is not None:
         raise SettingsError("embodied costs (a time allocation in seconds) and real-time turns don't go together; "
                             "choose one")
+
+
+def _shown(value) -> str:
+    """A value as the refusal shows it: numbers as written, anything else with its type ('10' (a str))."""
+    if _is_number(value) or _is_int(value):
+        return f"{value}"
+    return f"{value!r} (a {type(value).__name__})"
 
 
 def check_costs(costs) -> None:
@@ -72,6 +86,7 @@ class EpisodeSettings:
         if not isinstance(self.fetch_from_pantry, bool):
             raise SettingsError(f"fetch_from_pantry must be true or false, got {self.fetch_from_pantry!r}")
         check_costs(self.costs)
+        check_questions(self.turns, self.budget, self.costs)
         if self.weights is not None:
             from dialog.user_weights import weights_from_record
 

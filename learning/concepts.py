@@ -6,6 +6,8 @@ concept, negative for the others.
 
 from __future__ import annotations
 
+from numbers import Real
+
 import numpy as np
 
 from learning.gp import BinaryGPClassifier
@@ -15,12 +17,31 @@ from learning.gp import BinaryGPClassifier
 RELATIVE_STD_FLOOR = 1e-3
 
 
-def checked_rows(X, n_features: int, what: str = "rows") -> np.ndarray:
-    """``X`` as a finite float (n, n_features) matrix; a ValueError naming the problem otherwise."""
+def _real_array(values, refusal: str) -> np.ndarray:
+    """``values`` as a float array when they are real numbers (ints or floats), else ValueError(``refusal``)."""
     try:
-        X = np.asarray(X, dtype=float)
+        raw = np.asarray(values)
     except (TypeError, ValueError):
-        raise ValueError(f"{what} must be numbers in an (n, {n_features}) matrix") from None
+        raise ValueError(refusal) from None
+    kind = raw.dtype.kind
+    if kind == "O":
+        wrong = [v for v in raw.reshape(-1) if isinstance(v, (bool, np.bool_)) or not isinstance(v, (Real, np.number))
+                 or isinstance(v, (complex, np.complexfloating))]
+        if wrong:
+            raise ValueError(f"{refusal}, got {wrong[0]!r} ({type(wrong[0]).__name__})")
+    elif kind not in "iuf":
+        shown = {"c": "complex numbers", "b": "booleans", "U": "text", "S": "bytes"}.get(kind, f"dtype {raw.dtype}")
+        raise ValueError(f"{refusal}, got {shown}")
+    try:
+        return np.asarray(raw, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(refusal) from None
+
+
+def checked_rows(X, n_features: int, what: str = "rows") -> np.ndarray:
+    """``X`` as a finite float (n, n_features) matrix; a ValueError naming the problem otherwise. Only real
+    numbers are taken: complex values (which numpy would cast to their real part), booleans and text are refused."""
+    X = _real_array(X, f"{what} must be real numbers in an (n, {n_features}) matrix")
     if X.ndim != 2 or X.shape[1] != n_features:
         raise ValueError(f"{what} must be an (n, {n_features}) matrix, got shape {X.shape}")
     bad = ~np.isfinite(X)
@@ -33,10 +54,7 @@ def checked_rows(X, n_features: int, what: str = "rows") -> np.ndarray:
 
 def checked_row(x, n_features: int, what: str = "row") -> np.ndarray:
     """``x`` as a finite float vector of ``n_features`` values; a ValueError naming the problem otherwise."""
-    try:
-        x = np.asarray(x, dtype=float)
-    except (TypeError, ValueError):
-        raise ValueError(f"{what} must be {n_features} numbers") from None
+    x = _real_array(x, f"{what} must be {n_features} real numbers")
     if x.shape != (n_features,):
         raise ValueError(f"{what} must hold {n_features} feature values, got shape {x.shape}")
     return checked_rows(x[None, :], n_features, what)[0]

@@ -19,7 +19,8 @@ from learning.actions import ACTION_KINDS, DEFAULT_COSTS, Action, NoQuery, valid
 from learning.answers import AnswerError, Change
 from learning.classifier import ConceptClassifier
 from learning.concepts import checked_rows, normalise_rows
-from learning.errors import TeachbotError
+from learning.errors import SettingsError, TeachbotError
+from learning.limits import check_limit, check_questions
 from learning.state import LearningState
 from learning.strategies import Strategy, make_strategy
 
@@ -60,22 +61,26 @@ class TeachingLoop:
                  change_every: int = 5, costs: dict | None = None, seed: int | np.random.Generator = 0,
                  feature_names=None):
         self.concepts, self._names = _concept_names(concepts)
+        check_limit("concepts", len(self.concepts))  # before any state is made
         self._labels = dict(zip(self._names, self.concepts))
         self._internal = dict(zip(self.concepts, self._names))
         self.strategy = make_strategy(strategy) if isinstance(strategy, str) else strategy
         if not callable(getattr(self.strategy, "choose", None)):
-            raise ValueError(f"strategy must be a strategy name or have a choose(state, rng) method, got {strategy!r}")
+            raise SettingsError(f"strategy must be a strategy name or have a choose(state, rng) method, "
+                                f"got {strategy!r}")
         if not _number(budget) or budget < 0:
-            raise ValueError(f"budget must be a number >= 0, got {budget!r}")
+            raise SettingsError(f"budget must be a number >= 0, got {budget!r}")
         for name, value in (("turns", turns), ("change_every", change_every)):
             if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
-                raise ValueError(f"{name} must be a whole number >= 1, got {value!r}")
+                raise SettingsError(f"{name} must be a whole number >= 1, got {value!r}")
         self.costs = validate_costs({"none": 0, **(DEFAULT_COSTS if costs is None else costs)})
+        check_limit("turns", turns)
+        check_questions(int(turns), float(budget), self.costs)
         self.budget, self.turns, self.change_every = float(budget), int(turns), int(change_every)
         self.rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
         self.feature_names = None if feature_names is None else tuple(str(n) for n in feature_names)
         if self.feature_names is not None and len(set(self.feature_names)) != len(self.feature_names):
-            raise ValueError("feature_names must be distinct")
+            raise SettingsError("feature_names must be distinct")
         self.state: LearningState | None = None if self.feature_names is None else self._new_state()
         self.scenes = 0  # scenes observed so far
         self._scene_turn = 0  # the turn at which the latest scene was observed
@@ -147,10 +152,13 @@ class TeachingLoop:
     def _internal_answer(self, action: Action, answer):
         """The answer in the state's terms (concept names as strings); ``LearningState.apply`` checks the rest."""
         if action.kind == "label" and answer is not None:
+            plain = _plain(answer)
             try:
-                name = self._internal.get(_plain(answer))
+                name = self._internal.get(plain)
             except TypeError:  # unhashable
                 name = None
+            if name is not None and type(plain) is not type(self._labels[name]):
+                name = None  # True, 1.0 and 1+0j equal the concept 1 but are not it
             if name is None:
                 raise AnswerError(f"the answer to a label query is one of the concepts {list(self.concepts)} "
                                   f"(or None to skip), got {answer!r}")
@@ -233,19 +241,23 @@ def admissible(state: LearningState, action: Action) -> tuple[Action, str]:
 def _concept_names(concepts) -> tuple[tuple, tuple[str, ...]]:
     """The caller's concepts (numpy scalars as plain values) and the string names the state uses for them."""
     if isinstance(concepts, (str, bytes)) or not np.iterable(concepts):
-        raise ValueError(f"concepts must be a sequence of labels such as np.unique(y), got {concepts!r}")
+        raise SettingsError(f"concepts must be a sequence of labels such as np.unique(y), got {concepts!r}")
     labels = tuple(_plain(c) for c in concepts)
     if not labels:
-        raise ValueError("at least one concept is needed")
+        raise SettingsError("at least one concept is needed")
+    wrong = [c for c in labels if c is None or isinstance(c, complex) or (isinstance(c, float) and c != c)]
+    if wrong:
+        raise SettingsError(f"concepts must be labels such as strings or whole numbers (not None, NaN or complex "
+                         f"numbers), got {wrong[0]!r} in {list(labels)!r}")
     try:
         distinct = len(set(labels))
     except TypeError:
-        raise ValueError(f"concepts must be hashable labels (strings, numbers), got {list(labels)!r}") from None
+        raise SettingsError(f"concepts must be hashable labels (strings, numbers), got {list(labels)!r}") from None
     if distinct != len(labels):
-        raise ValueError(f"concepts must be distinct, got {list(labels)!r}")
+        raise SettingsError(f"concepts must be distinct, got {list(labels)!r}")
     names = tuple(c if isinstance(c, str) else str(c) for c in labels)
     if len(set(names)) != len(names):
-        raise ValueError(f"concepts {list(labels)!r} are not distinct once written as text")
+        raise SettingsError(f"concepts {list(labels)!r} are not distinct once written as text")
     return labels, names
 
 

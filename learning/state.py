@@ -19,6 +19,7 @@ from learning.actions import DEFAULT_COSTS, Action, validate_costs
 from learning.answers import AnswerError, Change, DemoRow, check_answer, feature_indices
 from learning.concepts import ConceptModels, FeatureScaler, checked_rows
 from learning.features.selection import SELECTION_METHODS, computational_subsets
+from learning.limits import check_limit
 from learning.progress import Progress, SceneView, read_only
 
 SOURCES = ("label", "demo")  # how a training example may have been obtained
@@ -49,6 +50,7 @@ class LearningState:
             raise ValueError(f"feature_selection must be None or one of {', '.join(SELECTION_METHODS[1:])}, got "
                              f"{feature_selection!r}")
         self.feature_selection = feature_selection
+        check_limit("concepts", len(concepts), "concepts")
         if budget < 0 or turns < 1:
             raise ValueError(f"budget must be >= 0 and turns >= 1, got budget {budget}, turns {turns}")
         self.concepts = tuple(concepts)
@@ -71,6 +73,7 @@ class LearningState:
     def observe_scene(self, scene_id: int, X: np.ndarray) -> None:
         """A new observation of the scene; a changed scene also widens the scaler's pool."""
         X = checked_rows(X, len(self.feature_names), f"scene {scene_id} matrix (objects x features)")
+        check_limit("scene_objects", len(X), f"objects (rows) in scene {scene_id}")
         if scene_id != self._scene.scene_id:
             scaler = self._scaler.copy()
             scaler.update(X)

@@ -101,7 +101,7 @@ def read_obj(file: str, with_uvs: bool = False) -> MeshArrays:
         return parse_obj(file, with_uvs)
     if cached.is_file():
         try:
-            with np.load(cached) as data:
+            with np.load(cached, allow_pickle=False) as data:
                 return MeshArrays(data["positions"], data["uvs"] if "uvs" in data else None, data["faces"])
         except (OSError, ValueError, KeyError):
             pass  # a damaged cache file is parsed again and replaced

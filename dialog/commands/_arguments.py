@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import re
+import sys
 import textwrap
 from pathlib import Path
 
@@ -30,9 +31,36 @@ class TeachbotParser(argparse.ArgumentParser):
     def __init__(self, *args, **kwargs):
         kwargs.setdefault("formatter_class", HelpFormatter)
         super().__init__(*args, **kwargs)
+        self._arguments: list[str] = []
+
+    def parse_known_args(self, args=None, namespace=None):
+        self._arguments = list(sys.argv[1:] if args is None else args)  # for a value that looks like an option
+        return super().parse_known_args(args, namespace)
 
     def error(self, message: str):
-        self.exit(2, f"{self.prog}: {own_voice(message, self.prog)}\n")
+        self.exit(2, f"{self.prog}: {self._dash_value(message) or own_voice(message, self.prog)}\n")
+
+    def _dash_value(self, message: str) -> str | None:
+        """``--time -5s``: argparse takes ``-5s`` for an option and says "expected one argument"; say what is
+        wrong with the value instead (its type's message), or how to give a value that starts with '-'."""
+        named = re.fullmatch(r"argument (\S+?)(?:/(\S+))?: expected one argument", message)
+        if not named:
+            return None
+        options = [o for o in (named.group(1), named.group(2)) if o]
+        spots = [i for i, word in enumerate(self._arguments) if word in options]
+        if not spots or spots[-1] + 1 >= len(self._arguments):
+            return None
+        option, value = self._arguments[spots[-1]], self._arguments[spots[-1] + 1]
+        action = self._option_string_actions.get(option)
+        if not value.startswith("-") or action is None:
+            return None
+        try:
+            if callable(action.type):
+                action.type(value)
+        except (argparse.ArgumentTypeError, ValueError, TypeError) as error:
+            return own_voice(f"argument {option}: invalid {getattr(action.type, '__name__', 'value')} value: "
+                             f"'{value}'", self.prog) if not str(error) else f"{option}: {error}"
+        return f"{option}: '{value}' starts with '-' and reads as an option; write {option}={value}"
 
 
 def own_voice(message: str, prog: str) -> str:
@@ -58,14 +86,38 @@ def own_voice(message: str, prog: str) -> str:
     return message
 
 
+ASCII_WHOLE = re.compile(r"[+-]?[0-9]+")
+ASCII_NUMBER = re.compile(r"[+-]?([0-9]+\.?[0-9]*|\.[0-9]+)([eE][+-]?[0-9]+)?")
+
+
+def _read_number(text: str, kind):
+    """``text`` as ``kind`` (int or float) written with ASCII digits only: Python's int() and float() also take
+    '٣' (an Arabic-Indic 3) and '1_0' (10), which a command line must not read as numbers."""
+    pattern = ASCII_WHOLE if kind is int else ASCII_NUMBER
+    if not pattern.fullmatch(text.strip()):
+        if kind is float and text.strip().lower().lstrip("+-") in ("inf", "infinity", "nan"):
+            return float(text)
+        raise ValueError(text)
+    return kind(text)
+
+
+def _ascii_hint(text: str, kind) -> str:
+    """What to say when Python would have read ``text`` as a number the command line refuses ('٣', '1_0')."""
+    try:
+        kind(text)
+    except ValueError:
+        return ""
+    return "; write numbers in ASCII digits 0-9, without '_'"
+
+
 def _number(text: str, kind, what: str):
     """``text`` read as ``kind`` (int or float), finite; argparse's error names what was expected."""
     try:
-        value = kind(text)
+        value = _read_number(text, kind)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"expected {what}, got '{text}'") from None
+        raise argparse.ArgumentTypeError(f"expected {what}, got '{text}'{_ascii_hint(text, kind)}") from None
     if kind is float and value != value or value in (float("inf"), float("-inf")):
-        raise argparse.ArgumentTypeError(f"expected {what}, got '{text}'")
+        raise argparse.ArgumentTypeError(f"expected {what}, got '{text}', which is not a finite number")
     return value
 
 
@@ -80,12 +132,13 @@ def _at_least(kind, what: str, minimum: float, too_small: str):
 
 
 def _whole_number(example: str):
-    """An argparse type: a whole number of 0 or more; the error gives ``example`` of what to write."""
+    """An argparse type: a whole number of 0 or more in ASCII digits; the error gives ``example`` of what to write."""
     def parse(text: str) -> int:
         try:
-            value = int(text)
+            value = _read_number(text, int)
         except ValueError:
-            raise argparse.ArgumentTypeError(f"'{text}' is not a whole number ({example})") from None
+            raise argparse.ArgumentTypeError(f"'{text}' is not a whole number ({example}){_ascii_hint(text, int)}") \
+                from None
         if value < 0:
             raise argparse.ArgumentTypeError(f"'{text}' is negative ({example})")
         return value
@@ -95,6 +148,7 @@ def _whole_number(example: str):
 seed = _whole_number("give a seed of 0 or more, e.g. --seed 0")
 seeds = _whole_number("give one or more seeds, e.g. --seeds 0 1 2")
 data_seed = _whole_number("give the seed the data sets are rendered from, 0 or more, e.g. --data-seed 1")
+stage = _whole_number("give a state stage of 0 or more, e.g. --stage 1")
 
 
 def task_names() -> list[str]:
@@ -203,7 +257,7 @@ def time_allocation(text: str) -> tuple[str, float]:
     unit = "seconds" if raw.lower().endswith("s") else "turns"
     number = raw[:-1].strip() if unit == "seconds" else raw
     try:
-        value = float(number) if unit == "seconds" else int(number)
+        value = _read_number(number, float if unit == "seconds" else int)
     except ValueError:
         raise argparse.ArgumentTypeError(f"'{text}' is not {TIME_FORMS}") from None
     if unit == "seconds" and not (value > 0 and value != float("inf")):
@@ -231,6 +285,7 @@ def resolve_time(args, defaults: EpisodeSettings = DEFAULTS) -> tuple[int, float
     quiet turns as the seconds hold."""
     from dialog.embodied import default_allocation, load_embodied_costs
     from learning.errors import SettingsError
+    from learning.limits import check_limit
 
     unit, value = args.time if args.time is not None else (None, None)
     turns_given = args.turns != defaults.turns
@@ -243,6 +298,7 @@ def resolve_time(args, defaults: EpisodeSettings = DEFAULTS) -> tuple[int, float
                                 f"allocation is in turns, e.g. --time {turns})")
         return turns, None
     seconds = float(value) if unit == "seconds" else default_allocation()
+    check_limit("seconds", seconds, "--time")  # before the turns cap is worked out from it
     if unit != "turns" and not turns_given:
         turns = max(1, int(-(-seconds // load_embodied_costs().quiet)))
     return turns, seconds

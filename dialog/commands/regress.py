@@ -24,6 +24,7 @@ from dialog.output_paths import check_writable, writing
 from dialog.user_weights import named_weights, read_named_weights
 from learning.datafiles import inside
 from learning.errors import SettingsError
+from learning.limits import check_limit
 from learning.strategies import STRATEGY_NAMES
 
 
@@ -74,6 +75,8 @@ def _embodied_seconds(args: argparse.Namespace) -> float | None:
 
 
 def run(args: argparse.Namespace) -> int:
+    if args.workers is not None:
+        check_limit("workers", args.workers, "--workers")  # before the suite's data sets are loaded
     original = load_suite(args.suite, known_strategies=STRATEGY_NAMES).with_weights(read_named_weights(args.weights))
     kind = get_kind(original.kind)
     suite = kind.load(original.with_overrides(strategies=args.strategies, seeds=args.seeds, budget=args.budget,

@@ -16,6 +16,7 @@ from dialog.commands._arguments import (
     kitchen_names,
     positive_int,
     seed,
+    stage,
 )
 from dialog.output_paths import check_writable, file_argument, make_parent
 from learning.errors import SettingsError
@@ -37,7 +38,7 @@ def register(commands) -> None:
     add_scene_options(show)
     show.add_argument("--objects", type=positive_int, default=None,
                       help="objects in the scene (default: the task's objects_per_scene)")
-    show.add_argument("--stage", type=int, default=None,
+    show.add_argument("--stage", type=stage, default=None,
                       help="state stage for tasks whose objects change state (default: the first scene's, as "
                            "demo shows it)")
     show.add_argument("--png", type=file_argument, default=None, help="also write the annotated camera picture (.png)")

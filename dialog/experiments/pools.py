@@ -24,6 +24,7 @@ from bullet_world.catalogue import Task, load_task
 from bullet_world.datasets import Pool, load_datasets
 from bullet_world.scene import Scene, SceneTruth
 from learning.errors import SettingsError
+from learning.limits import check_limit
 
 PLAN_OPTIONS = ("pool_size", "test_size", "objects_per_scene")
 
@@ -54,6 +55,9 @@ def load_pools(task: str, kitchen: str, datasets: int, plan_options: tuple = (),
     """
     if isinstance(data_seed, bool) or not isinstance(data_seed, int | np.integer) or data_seed < 0:
         raise SettingsError(f"data seed must be a whole number >= 0, got {data_seed!r}")
+    if isinstance(datasets, bool) or not isinstance(datasets, int | np.integer) or datasets < 1:
+        raise SettingsError(f"datasets must be a whole number of at least 1 (training data sets), got {datasets!r}")
+    check_limit("datasets", datasets)
     key = (task, kitchen, int(datasets), tuple(plan_options), int(data_seed))
     if key not in _loaded:
         while len(_loaded) >= KEPT_POOL_SETS:

@@ -13,7 +13,8 @@ from pathlib import Path
 from learning import datafiles
 from learning.actions import DEFAULT_COSTS
 from learning.datafiles import check_keys, integer, number, numbers, read_toml, section, tables, text, texts
-from learning.errors import DataFileError, did_you_mean
+from learning.errors import DataFileError, SettingsError, did_you_mean
+from learning.limits import check_limit, maximum
 from learning.significance import ALTERNATIVES
 
 SUITE_DIR = Path(__file__).resolve().parents[1] / "suites"
@@ -120,10 +121,13 @@ class Suite:
             suite = replace(suite, strategies=tuple(strategies), findings=tuple(
                 f for f in suite.findings if f.better in strategies and set(f.than) <= set(strategies)))
         if seeds:
+            _check_seeds(seeds, "--seeds", SettingsError)
             suite = replace(suite, seeds=tuple(seeds))
         if budget is not None:
+            check_limit("budget", budget, "--budget")
             suite = replace(suite, conditions=tuple(replace(c, budget=float(budget)) for c in suite.conditions))
         if datasets:
+            check_limit("datasets", datasets, "--datasets")
             suite = replace(suite, datasets=int(datasets))
         return suite
 
@@ -195,13 +199,17 @@ def _suite(table: dict, where: str, known_strategies) -> Suite:
         raise SuiteError(f"{where}: 'data_seed' is not accepted in a suite of kind 'recipes' (it renders no data sets)")
     findings = tuple(_finding(f, kind, strategies, names, f"{where} finding {i + 1}")
                      for i, f in enumerate(tables(table, "finding", where, [])))
+    seeds = numbers(table, "seeds", where, (0,), whole=True, low=0)
+    _check_seeds(seeds, f"{where}: seeds", SuiteError)
+    checkpoints = numbers(table, "checkpoints", where, whole=True, low=0)
+    _check_checkpoints(checkpoints, kind, table.get("axis", "questions"), conditions, where)
     return Suite(
         name=datafiles.name(table, "name", where, what="suite name"),
         description=text(table, "description", where, "", nonempty=False),
         kind=kind, task=text(table, "task", where, "pack-lunchbox"), kitchen=text(table, "kitchen", where, "kitchen-1"),
-        strategies=strategies, conditions=conditions, datasets=integer(table, "datasets", where, 5, low=1),
-        seeds=numbers(table, "seeds", where, (0,), whole=True, low=0),
-        checkpoints=numbers(table, "checkpoints", where, whole=True, low=0),
+        strategies=strategies, conditions=conditions,
+        datasets=integer(table, "datasets", where, 5, low=1, high=maximum("datasets")),
+        seeds=seeds, checkpoints=checkpoints,
         axis=text(table, "axis", where, "questions", choices=AXES), costs=_costs(table, where),
         teacher=_teacher(table, where), findings=findings, options=_options(table, kind, where), path=where,
         dataset=_plan(table, where), analysis=text(table, "analysis", where, "", nonempty=False),
@@ -213,11 +221,43 @@ def _condition(table: dict, where: str, objects_per_scene: int | None = None) ->
     """One [[condition]]; ``objects_per_scene`` is the suite's scene size, which a condition may override."""
     check_keys(table, where, required=CONDITION_FIELDS, optional=CONDITION_OPTIONAL)
     return Condition(datafiles.name(table, "name", where, what="condition name"),
-                     number(table, "budget", where, low=0.0),
-                     integer(table, "turns", where, low=1), integer(table, "change_every", where, low=1),
-                     number(table, "seconds", where, None, above=0.0),
+                     number(table, "budget", where, low=0.0, high=maximum("budget")),
+                     integer(table, "turns", where, low=1, high=maximum("turns")),
+                     integer(table, "change_every", where, low=1),
+                     number(table, "seconds", where, None, above=0.0, high=maximum("seconds")),
                      integer(table, "objects_per_scene", where, objects_per_scene, low=1),
                      tuple(sorted(_teacher(table, where).items())))
+
+
+def _check_seeds(seeds, label: str, error: type[DataFileError] | type[SettingsError]) -> None:
+    """Each seed once (a seed given twice runs the same episodes twice), at most the limit of seeds."""
+    repeated = sorted({seed for seed in seeds if list(seeds).count(seed) > 1})
+    if repeated:
+        raise error(f"{label}: seed {repeated[0]} is given twice; give each seed once")
+    if len(seeds) > maximum("seeds"):
+        raise error(f"{label}: {len(seeds)} seeds are beyond the limit of {maximum('seeds')} seeds in one run "
+                    "(learning/data/limits.toml)")
+
+
+def _check_checkpoints(checkpoints, kind: str, axis, conditions: tuple[Condition, ...], where: str) -> None:
+    """Checkpoints in increasing order, at most the limit of them; an episodes suite's last one within the
+    longest condition (its turns, or its seconds on the seconds axis)."""
+    if any(later <= earlier for earlier, later in zip(checkpoints, checkpoints[1:])):
+        raise SuiteError(f"{where}: 'checkpoints' must be in increasing order, each once, got {list(checkpoints)}")
+    if len(checkpoints) > maximum("checkpoints"):
+        raise SuiteError(f"{where}: {len(checkpoints)} checkpoints are beyond the limit of {maximum('checkpoints')} "
+                         "(learning/data/limits.toml)")
+    if kind != "episodes" or not conditions or not checkpoints:
+        return
+    if axis == "seconds":
+        if any(c.seconds is None for c in conditions):
+            return  # the seconds come from --embodied-costs' default allocation
+        longest, unit = max(float(c.seconds) for c in conditions), "seconds"  # type: ignore[arg-type]
+    else:
+        longest, unit = max(c.turns for c in conditions), "turns"
+    if checkpoints[-1] > longest:
+        raise SuiteError(f"{where}: checkpoint {checkpoints[-1]} lies beyond every condition (the longest has "
+                         f"{longest:g} {unit}); give checkpoints within it")
 
 
 def _finding(table: dict, kind: str, strategies: tuple, conditions: list, where: str) -> Finding:
@@ -250,7 +290,11 @@ def _costs(table: dict, where: str) -> dict:
 
 def _teacher(table: dict, where: str) -> dict:
     """The [teacher] table: kind (scripted or oracle) and the scripted teacher's rates, each 0..1."""
-    teacher, here = section(table, "teacher", where, {}), f"{where} [teacher]"
+    return teacher_options(section(table, "teacher", where, {}), f"{where} [teacher]")
+
+
+def teacher_options(teacher: dict, here: str) -> dict:
+    """A scripted teacher's options (a suite's [teacher], the Gymnasium environment's ``teacher``), checked."""
     check_keys(teacher, here, optional=("kind", *TEACHER_RATES))
     result = {"kind": text(teacher, "kind", here, choices=TEACHER_KINDS)} if "kind" in teacher else {}
     return result | {key: number(teacher, key, here, low=0.0, high=1.0) for key in TEACHER_RATES if key in teacher}

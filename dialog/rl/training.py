@@ -21,6 +21,7 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from learning.errors import SettingsError, SetupError
+from learning.limits import check_limit
 from learning.rl.observation import ObservationLayout
 from learning.rl.policy_file import QuestionerPolicy
 
@@ -47,6 +48,8 @@ class TrainingConfig:
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int) or value < 1:
                 raise SettingsError(f"{name} must be a whole number of 1 or more, got {value!r}")
+        check_limit("training_steps", self.steps, "steps")
+        check_limit("workers", self.envs, "envs")
         for name, low, high in (("learning_rate", 0.0, 1.0), ("gamma", 0.0, 1.0), ("gae_lambda", 0.0, 1.0)):
             value = getattr(self, name)
             if not isinstance(value, int | float) or isinstance(value, bool) or not low < value <= high:

@@ -18,6 +18,7 @@ from dialog.teachers import SCRIPTED_OPTIONS
 from learning import datafiles as df
 from learning.actions import DEFAULT_COSTS
 from learning.errors import DataFileError
+from learning.limits import maximum
 from learning.strategies import STRATEGY_NAMES
 
 ORDERINGS = ("latin", "given")
@@ -128,14 +129,14 @@ def _condition(table: dict, where: str) -> Condition:
     name = df.name(table, "name", where, what="condition name")
     costs = df.section(table, "costs", where, default=dict(DEFAULT_COSTS))
     df.check_keys(costs, f"{where} costs", required=tuple(DEFAULT_COSTS))
-    realtime = df.number(table, "realtime", where, default=None, above=0)
+    realtime = df.number(table, "realtime", where, default=None, above=0, high=maximum("realtime"))
     return Condition(
         name=name,
         instructions=df.text(table, "instructions", where, default="Teach the robot the words of the task."),
         task=df.text(table, "task", where, default=DEFAULTS.task, choices=available("tasks")),
         kitchen=df.text(table, "kitchen", where, default=DEFAULTS.kitchen, choices=available("kitchens")),
         strategy=df.text(table, "strategy", where, choices=STRATEGY_NAMES),
-        budget=df.number(table, "budget", where, default=DEFAULTS.budget, low=0),
+        budget=df.number(table, "budget", where, default=DEFAULTS.budget, low=0, high=maximum("budget")),
         turns=df.integer(table, "turns", where, default=DEFAULTS.turns, low=1, high=500),
         change_every=df.integer(table, "change_every", where, default=DEFAULTS.change_every, low=1),
         realtime=realtime,

@@ -23,6 +23,7 @@ import numpy as np
 from learning.decision.features import FEATURE_NAMES
 from learning.decision.weights_file import load_weights
 from learning.errors import SettingsError, did_you_mean
+from learning.limits import check_limit
 
 WEIGHTS_DIRECTORY = Path(__file__).resolve().parent / "presets"
 PRESETS = ("dt", "dt-iros", "dt-task", "dt-task-env")
@@ -41,8 +42,10 @@ def weight_vector(weights: Mapping[str, float] | Sequence[float] | np.ndarray, s
             raise ValueError(f"{source}: expected {len(FEATURE_NAMES)} weights in the order "
                              f"{', '.join(FEATURE_NAMES)}; got {len(values)}")
     for name, value in zip(FEATURE_NAMES, values):
-        if isinstance(value, bool) or not isinstance(value, (int, float, np.number)) or not math.isfinite(value):
-            raise ValueError(f"{source}: weight of {name} must be a finite number, got {value!r}")
+        if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) \
+                or not math.isfinite(value):
+            raise ValueError(f"{source}: weight of {name} must be a finite real number, got {value!r}")
+        check_limit("weight", abs(value), f"{source}: weight of {name} (its size)")
     return np.array(values, dtype=float)
 
 

@@ -32,6 +32,7 @@ import numpy as np
 from learning.datafiles import read_toml
 from learning.errors import DataFileError
 from learning.irl.demonstrations import check_feature_names
+from learning.limits import check_limit
 
 WEIGHTS_TABLE = "weights"
 PROVENANCE_TABLE = "provenance"
@@ -52,6 +53,8 @@ class DecisionWeights:
             raise ValueError(f"weights: expected {len(names)} values (one per feature), got shape {values.shape}")
         if not np.all(np.isfinite(values)):
             raise ValueError("weights: every weight must be a finite number")
+        if values.size:
+            check_limit("weight", float(np.max(np.abs(values))), "weights: the largest weight (its size)")
         values.setflags(write=False)
         object.__setattr__(self, "feature_names", names)
         object.__setattr__(self, "values", values)
@@ -151,6 +154,7 @@ def weights_from_mapping(data: Mapping, feature_names: Sequence[str] | None = No
     for name, value in table.items():
         if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
             raise DataFileError(f"{source}: weight {name!r} must be a finite number, got {value!r}")
+        check_limit("weight", abs(value), f"{source}: weight {name!r} (its size)", DataFileError)
     try:
         names = check_feature_names(list(table), f"{source} [{WEIGHTS_TABLE}]")
         if feature_names is not None:

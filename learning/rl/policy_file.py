@@ -17,6 +17,7 @@ from __future__ import annotations
 import hashlib
 import io
 import os
+import zipfile
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -27,6 +28,8 @@ from learning.datafiles import check_keys, flag, integer, numbers, read_toml, se
 from learning.decision.features import FEATURE_NAMES
 from learning.decision.weights_file import check_bare_key, toml_value
 from learning.errors import DataFileError
+from learning.limits import limit as limit_of
+from learning.limits import maximum
 from learning.rl.observation import ObservationLayout
 
 FORMAT = "teachbot-questioner"
@@ -148,26 +151,82 @@ def load_policy(path: str | Path) -> QuestionerPolicy:
     check_keys(observed, there, required=("concepts", "max_objects", "whatif", "features"))
     if tuple(texts(observed, "features", there)) != FEATURE_NAMES:
         raise DataFileError(f"{there}: features must be {list(FEATURE_NAMES)} (the decision features, in order)")
-    layout = ObservationLayout(tuple(texts(observed, "concepts", there, nonempty=True)),
-                               integer(observed, "max_objects", there, low=1), flag(observed, "whatif", there))
-    npz = path.with_name(text(table, "weights", here))
-    if npz.parent != path.parent or not npz.is_file():
-        raise DataFileError(f"{here}: weights file '{table['weights']}' is not beside {path.name}; keep the .toml "
-                            "and its .npz together")
+    npz = weights_beside(path, text(table, "weights", here), here)
     raw = npz.read_bytes()
     if hashlib.sha256(raw).hexdigest() != text(table, "sha256", here):
         raise DataFileError(f"{npz}: its SHA-256 is not the one {path.name} records; the weights changed since the "
                             "policy was saved (train again, or restore the file)")
-    try:
-        with np.load(io.BytesIO(raw), allow_pickle=False) as arrays:
-            n = len(arrays.files) // 2
-            weights = tuple(np.array(arrays[f"w{k}"], dtype=np.float64) for k in range(n))
-            biases = tuple(np.array(arrays[f"b{k}"], dtype=np.float64) for k in range(n))
-    except (KeyError, ValueError, OSError) as error:
-        raise DataFileError(f"{npz}: not a questioner weights file (arrays w0, b0, w1, b1, ...): {error}") from None
     layers = numbers(table, "layers", here, whole=True, low=1)
-    policy = QuestionerPolicy(layout, weights, biases, text(table, "activation", here), dict(data.get("provenance",
-                                                                                                      {})))
+    if len(layers) < 2:
+        raise DataFileError(f"{here}: layers must list the input width and each layer's width (at least two "
+                            f"numbers), got {list(layers)}")
+    concepts = texts(observed, "concepts", there, nonempty=True)
+    if len(concepts) > maximum("concepts"):
+        raise DataFileError(f"{there}: {len(concepts)} concepts are beyond the limit of {maximum('concepts')} "
+                            "(learning/data/limits.toml)")
+    weights, biases = read_arrays(npz, raw, len(layers) - 2)
+    try:
+        layout = ObservationLayout(tuple(concepts),
+                                   integer(observed, "max_objects", there, low=1, high=maximum("scene_objects")),
+                                   flag(observed, "whatif", there))
+        policy = QuestionerPolicy(layout, weights, biases, text(table, "activation", here, choices=ACTIVATIONS),
+                                  dict(section(data, "provenance", where, {})))
+    except DataFileError as error:
+        message = str(error)
+        raise DataFileError(message if message.startswith(where) else f"{npz}: {message}") from None
+    except ValueError as error:  # the layout's own checks (SettingsError)
+        raise DataFileError(f"{there}: {error}") from None
     if list(layers) != policy.layers:
         raise DataFileError(f"{here}: layers {list(layers)} do not match the weights' {policy.layers}")
     return policy
+
+
+def weights_beside(path: Path, name: str, here: str) -> Path:
+    """The weights file ``name`` that a policy's TOML names: a plain file name in the TOML's own folder, not a
+    path ('../x', '/etc/passwd', '.'), and not a symbolic link that leads out of that folder."""
+    folder = path.parent
+    plain = name not in (".", "..") and "/" not in name and "\\" not in name and "\x00" not in name
+    if not plain or not name.endswith(".npz"):
+        raise DataFileError(f"{here}: weights {name!r} is not accepted; it must be the name of the .npz file beside "
+                            f"{path.name} (a file name ending in .npz, no folder)")
+    npz = folder / name
+    if not npz.is_file():
+        raise DataFileError(f"{here}: weights file '{name}' is not beside {path.name}; keep the .toml and its .npz "
+                            "together")
+    if not npz.resolve().is_relative_to(folder.resolve()):
+        raise DataFileError(f"{npz}: is a link to {npz.resolve()}, outside the policy's folder {folder}; copy the "
+                            "weights into the folder instead")
+    return npz
+
+
+def read_arrays(npz: Path, raw: bytes, last: int) -> tuple[tuple[np.ndarray, ...], tuple[np.ndarray, ...]]:
+    """w0, b0 .. w{last}, b{last} from the NPZ's bytes (never a pickle): real floats, finite, each within the
+    limit of a weight; anything else is one DataFileError naming the file."""
+    expected = sorted(f"{kind}{k}" for k in range(last + 1) for kind in "wb")
+    accepted = f"an NPZ of the arrays {', '.join(expected)} (real floats)"
+    if not raw.startswith(b"PK"):
+        raise DataFileError(f"{npz}: not an NPZ archive (a .npz is a zip of .npy arrays; got "
+                            f"{'an empty file' if not raw else 'something else'}); expected {accepted}")
+    arrays = {}
+    try:
+        with np.load(io.BytesIO(raw), allow_pickle=False) as archive:
+            if sorted(archive.files) != expected:
+                raise DataFileError(f"{npz}: holds the arrays {sorted(archive.files)}; expected {accepted}")
+            for name in expected:
+                arrays[name] = archive[name]
+    except DataFileError:
+        raise
+    except (KeyError, ValueError, OSError, EOFError, zipfile.BadZipFile, NotImplementedError) as error:
+        raise DataFileError(f"{npz}: is damaged or not {accepted}: {error}") from None
+    limit = maximum("weight")
+    for name, array in arrays.items():
+        if array.dtype.kind != "f":
+            raise DataFileError(f"{npz}: array {name} holds {array.dtype} values; expected real floats")
+        if not np.all(np.isfinite(array)):
+            raise DataFileError(f"{npz}: array {name} holds NaN or infinite values; weights must be finite")
+        if array.size and float(np.max(np.abs(array))) > limit:
+            raise DataFileError(f"{npz}: array {name} holds {float(np.max(np.abs(array))):g}, beyond the limit of "
+                                f"{limit:g} {limit_of('weight').what} (learning/data/limits.toml)")
+    weights = tuple(np.array(arrays[f"w{k}"], dtype=np.float64) for k in range(last + 1))
+    biases = tuple(np.array(arrays[f"b{k}"], dtype=np.float64) for k in range(last + 1))
+    return weights, biases

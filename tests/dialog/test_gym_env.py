@@ -109,3 +109,55 @@ def test_async_vector_envs_step_and_agree_with_a_single_env():
             assert rewards[0] == pytest.approx(single_reward)
     finally:
         vector.close()
+
+
+# -- issue 24: Gymnasium's conventions; every argument checked, none ignored --------------------------------
+@pytest.mark.parametrize("action", [1.7, "0", True, np.bool_(True), np.float64(1.0), np.array([1]), None])
+def test_an_action_outside_the_action_space_raises_as_gymnasium_envs_do(action):
+    from dialog.gym_env import InvalidActionError
+
+    env = QuestioningEnv(**SMALL)
+    env.reset(seed=0)
+    assert not (env.action_space.contains(action) and not isinstance(action, bool | np.bool_))
+    with pytest.raises(AssertionError, match="is not a slot") as raised:
+        env.step(action)
+    assert isinstance(raised.value, InvalidActionError) and isinstance(raised.value, SettingsError)
+    assert env.records[-1].get("turn") is None  # nothing was played
+    env.step(np.int64(0))
+    env.step(np.array(0))  # a 0-d integer array is in Discrete, as Gymnasium says
+    assert env.manager.turn == 2
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    ({"datasets": -3}, "datasets must be a whole number of 1 or more, got -3"),
+    ({"datasets": 10**6}, "datasets: 1000000 is beyond the limit of 100"),
+    ({"datasets": 2.0}, "datasets must be a whole number"),
+    ({"whatif": "no"}, "whatif must be True or False .*got 'no'"),
+    ({"budget": "10"}, r"budget must be a number of zero or more cost units, got '10' \(a str\)"),
+    ({"data_seed": -1}, "data_seed must be a whole number of 0 or more"),
+    ({"teacher": "oracle"}, "teacher must be a dict"),
+    ({"teacher": {"mislabel_rate": 2}}, "'mislabel_rate' must be >= 0 and <= 1"),
+    ({"turns": 10**8}, "turns: 100000000 is beyond the limit of 10000"),
+    ({"transcript": 3}, "transcript must be None or a path"),
+])
+def test_bad_settings_are_refused_with_what_is_wrong(kwargs, message):
+    from learning.errors import TeachbotError
+
+    with pytest.raises(TeachbotError, match=message):
+        gym.make(ENV_ID, **{**SMALL, **kwargs})
+
+
+@pytest.mark.parametrize("options, message", [
+    ({"budget": 3}, "reset options must be a dict with the keys dataset"), ("fast", "reset options must be a dict"),
+    ({"dataset": 5}, r"'dataset' must be a whole number 0\.\.4"), ({"dataset": True}, "'dataset' must be"),
+])
+def test_reset_options_are_validated_not_ignored(options, message):
+    env = QuestioningEnv(**SMALL)
+    with pytest.raises(SettingsError, match=message):
+        env.reset(seed=0, options=options)
+    with pytest.raises(SettingsError, match="seed must be None or a whole number"):
+        env.reset(seed=-1)
+    env.reset(seed=7, options={"dataset": 3})
+    assert env.records[0]["session"]["dataset"] == 3  # not 7 mod 5
+    env.reset(seed=7, options={})
+    assert env.records[0]["session"]["dataset"] == 2

@@ -67,3 +67,21 @@ def test_learning_weights_without_validation_episodes_is_refused_before_fitting(
 
     with pytest.raises(SettingsError, match=r"n_validation must be at least 1 \(.*\), got 0"):
         learn_weights("shipped", n_validation=0)
+
+
+@pytest.mark.parametrize("value", ["1e308", "-2e6"])
+def test_a_weight_beyond_the_stated_magnitude_is_refused_naming_the_file(tmp_path, capsys, value):
+    """Issue 24: DT weights of 1e308 ran; a weight must be finite and within learning/data/limits.toml's limit."""
+    from learning.errors import DataFileError
+
+    path = tmp_path / "w.toml"
+    path.write_text(f"[weights]\n{FEATURE_NAMES[0]} = {value}\n")
+    with pytest.raises(DataFileError, match=rf"{path}: weight '{FEATURE_NAMES[0]}' .*beyond the limit of 1e\+06"):
+        load_weights(path)
+    with pytest.raises(ValueError, match="beyond the limit of 1e"):
+        from learning.decision.weights import weight_vector
+
+        weight_vector({FEATURE_NAMES[0]: float(value)})
+    assert main(["demo", "--turns", "1", "--weights", str(path)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and str(path) in err[0] and "beyond the limit" in err[0], err

@@ -109,3 +109,106 @@ def test_the_strategy_takes_the_best_allowed_slot(rng, tmp_path):
     assert by_name.header_fields()["policy"]["file"] == str(path.resolve())
     with pytest.raises(DataFileError, match="no questioner policy file"):
         make_strategy("rl:nowhere.toml")
+
+
+# -- issue 24, item 5: the weights file a policy names, its arrays, and never a pickle ------------------------
+def _hostile(tmp_path, rng, arrays_bytes=None, weights=None, edit=None):
+    """A policy whose TOML names ``weights`` and records the SHA-256 of ``arrays_bytes`` (as a hostile edit
+    would, so the digest check does not stand in for the others); returns load_policy's refusal."""
+    import hashlib
+    import re
+
+    path = save_policy(tmp_path / "q.toml", random_policy(ObservationLayout(CONCEPTS, max_objects=8), rng))
+    if arrays_bytes is not None:
+        (tmp_path / "q.npz").write_bytes(arrays_bytes)
+    digest = hashlib.sha256((tmp_path / (weights or "q.npz")).read_bytes()
+                            if (tmp_path / (weights or "q.npz")).is_file() else b"").hexdigest()
+    text = re.sub(r'sha256 = ".*"', f'sha256 = "{digest}"', path.read_text())
+    if weights is not None:
+        text = re.sub(r'weights = ".*"', f'weights = "{weights}"', text)
+    path.write_text(edit(text) if edit else text)
+    with pytest.raises(DataFileError) as raised:
+        load_policy(path)
+    message = str(raised.value)
+    assert str(tmp_path / "q.") in message and "\n" not in message, message  # names the file
+    return message
+
+
+def _npz(arrays: dict) -> bytes:
+    import io
+
+    buffer = io.BytesIO()
+    np.savez(buffer, **arrays)
+    return buffer.getvalue()
+
+
+@pytest.mark.parametrize("weights", ["../../etc/passwd", "/etc/passwd", ".", "..", "sub/q.npz", "q.toml"])
+def test_a_policy_names_only_the_npz_beside_it(rng, tmp_path, weights):
+    assert "it must be the name of the .npz file beside q.toml" in _hostile(tmp_path, rng, weights=weights)
+
+
+def test_a_weights_link_out_of_the_policy_folder_is_refused(rng, tmp_path):
+    import os
+
+    outside = tmp_path / "elsewhere"
+    outside.mkdir()
+    inside = tmp_path / "policy"
+    inside.mkdir()
+    save_policy(outside / "q.toml", random_policy(ObservationLayout(CONCEPTS, max_objects=8), rng))
+    path = save_policy(inside / "q.toml", random_policy(ObservationLayout(CONCEPTS, max_objects=8), rng))
+    (inside / "q.npz").unlink()
+    os.symlink(outside / "q.npz", inside / "q.npz")
+    import hashlib
+    import re
+
+    digest = hashlib.sha256((outside / "q.npz").read_bytes()).hexdigest()
+    path.write_text(re.sub(r'sha256 = ".*"', f'sha256 = "{digest}"', path.read_text()))
+    with pytest.raises(DataFileError, match="is a link to .* outside the policy's folder"):
+        load_policy(path)
+
+
+def test_damaged_or_foreign_weights_files_are_refused_naming_the_file(rng, tmp_path):
+    layout = ObservationLayout(CONCEPTS, max_objects=8)
+    policy = random_policy(layout, rng)
+    arrays = {f"w{k}": w for k, w in enumerate(policy.weights)} | {f"b{k}": b for k, b in enumerate(policy.biases)}
+    good = _npz(arrays)
+    assert "got an empty file" in _hostile(tmp_path, rng, b"")
+    damaged = bytearray(good)
+    damaged[good.index(b"NUMPY") + 130] ^= 0xFF
+    assert "Bad CRC-32" in _hostile(tmp_path, rng, bytes(damaged))
+    import io
+
+    npy = io.BytesIO()
+    np.save(npy, policy.weights[0])
+    assert "not an NPZ archive" in _hostile(tmp_path, rng, npy.getvalue())
+    assert "array w0 holds complex128 values; expected real floats" in _hostile(
+        tmp_path, rng, _npz(arrays | {"w0": policy.weights[0] * (1 + 1j)}))
+    assert "array b0 holds int64 values" in _hostile(tmp_path, rng, _npz(arrays | {"b0": np.zeros(5, dtype=int)}))
+    assert "array w1 holds 1e+308, beyond the limit of 1e+06" in _hostile(
+        tmp_path, rng, _npz(arrays | {"w1": np.full_like(policy.weights[1], 1e308)}))
+    assert "holds the arrays ['b0', 'b1', 'w0', 'w1', 'x']" in _hostile(tmp_path, rng, _npz(arrays | {"x": np.ones(1)}))
+    assert "do not take" in _hostile(tmp_path, rng, _npz(arrays | {"w0": policy.weights[0][:, :3]}))
+    pickled = io.BytesIO()
+    np.savez(pickled, **(arrays | {"w0": np.array([{"a": 1}], dtype=object)}))
+    assert "is damaged or not an NPZ" in _hostile(tmp_path, rng, pickled.getvalue())
+    assert "activation 'sigmoid' is not one of" in _hostile(
+        tmp_path, rng, edit=lambda text: text.replace('activation = "tanh"', 'activation = "sigmoid"'))
+    assert "at least two numbers" in _hostile(
+        tmp_path, rng, edit=lambda text: text.replace(f"layers = {policy.layers}".replace("'", ""),
+                                                       f"layers = [{layout.size}]"))
+
+
+def test_no_source_file_loads_a_pickle():
+    """np.load is always called with allow_pickle=False; nothing calls pickle.load, torch.load or joblib.load."""
+    import re
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[2]
+    sources = [p for folder in ("bullet_world", "dialog", "learning", "robot", "scripts")
+               for p in (root / folder).rglob("*.py")]
+    assert len(sources) > 100
+    for path in sources:
+        text = path.read_text(encoding="utf-8")
+        for call in re.finditer(r"\b(?:np|numpy)\.load\(([^()]*(?:\([^()]*\)[^()]*)*)\)", text):
+            assert "allow_pickle=False" in call.group(1), f"{path}: {call.group(0)}"
+        assert not re.search(r"\b(?:pickle|torch|joblib|dill|cloudpickle)\.loads?\(", text), path

@@ -6,6 +6,7 @@ from sklearn.datasets import load_iris
 
 from learning import AnswerError, CallOrderError, DemoRow, LearningState, TeachingLoop, apply_answer
 from learning.actions import Decision, DemoQuery, FeatureQuery, LabelQuery, NoQuery
+from learning.errors import SettingsError
 from learning.strategies import STRATEGY_NAMES, Strategy
 
 X_IRIS, Y_IRIS = load_iris(return_X_y=True)
@@ -290,3 +291,55 @@ def test_every_strategy_meets_every_answer_and_every_error_without_changing_the_
         assert changes >= {("label", "example", False), ("label", "skipped", False), ("demo", "example", False),
                            ("demo", "absent", False), ("demo", "example", True), ("feature", "features", False),
                            ("none", "none", False)}
+
+
+# -- issue 24: complex numbers, booleans, floats where a concept is meant, None as a concept, limits ------------
+@pytest.mark.parametrize("bad, message", [
+    (X_IRIS[:5] * 1j, "real numbers .* got complex numbers"), (X_IRIS[:5] > 5, "got booleans"),
+    (X_IRIS[:5].astype(str), "got text"), (np.array([[1.0, 2.0, 3j, 4.0]], dtype=object), r"got 3j \(complex\)"),
+])
+def test_a_scene_of_anything_but_real_numbers_is_refused(bad, message):
+    loop = TeachingLoop([0, 1, 2], feature_names=NAMES)
+    refused(loop, lambda: loop.observe(bad), ValueError, message)
+
+
+@pytest.mark.parametrize("answer", [True, np.True_, 1 + 0j, 1.0, np.float64(1.0)])
+def test_a_label_equal_to_a_concept_but_not_of_its_kind_is_refused(answer):
+    loop = TeachingLoop([0, 1, 2], feature_names=NAMES, strategy=Scripted(LabelQuery(0)))
+    loop.observe(X_IRIS[:5])
+    assert loop.ask().kind == "label"
+    refused(loop, lambda: loop.tell(answer), AnswerError, "one of the concepts")
+    loop.tell(np.int64(1))  # a numpy integer is the concept 1
+    assert loop.history[-1].change.concept == "1"
+
+
+@pytest.mark.parametrize("answer", [0.0, True, 1 + 0j])
+def test_a_demonstration_index_must_be_a_whole_number(answer):
+    loop = TeachingLoop([0, 1, 2], feature_names=NAMES, strategy=Scripted(DemoQuery("0")))
+    loop.observe(X_IRIS[:5])
+    loop.ask()
+    refused(loop, lambda: loop.tell(answer), AnswerError, "index of an object")
+
+
+@pytest.mark.parametrize("concepts", [[None, "a"], [1.0, float("nan")], [1j, 2]])
+def test_none_nan_and_complex_concepts_are_refused(concepts):
+    with pytest.raises(SettingsError, match="not None, NaN or complex"):
+        TeachingLoop(concepts)
+
+
+def test_more_concepts_or_scene_objects_than_the_limits_are_refused_before_any_work():
+    from learning.limits import maximum
+
+    with pytest.raises(SettingsError, match="concepts: 10000 is beyond the limit of 32"):
+        TeachingLoop([str(i) for i in range(10_000)], strategy="dt-task")  # tried to allocate 107 GiB
+    loop = TeachingLoop([0, 1], feature_names=NAMES)
+    refused(loop, lambda: loop.observe(np.zeros((maximum("scene_objects") + 1, 4))), SettingsError,
+            "objects .rows. in scene 0: 129 is beyond the limit of 128")
+
+
+def test_an_episode_longer_or_with_more_questions_than_the_limits_is_refused():
+    with pytest.raises(SettingsError, match="turns: 100000000 is beyond the limit of 10000"):
+        TeachingLoop([0, 1], turns=100_000_000)
+    with pytest.raises(SettingsError, match="can pay for 5000 questions, beyond the limit of 2000"):
+        TeachingLoop([0, 1], turns=5000, budget=1e6)
+    TeachingLoop([0, 1], turns=5000, budget=40)  # quiet turns are cheap: 40 questions at most
