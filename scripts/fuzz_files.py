@@ -72,7 +72,7 @@ def make_kinds(conditions) -> list[Kind]:
     run1, run2 = (_study("run", "--participant", who, "--simulated") for who in ("P01", "P02"))
     demo = ["demo", "--turns", "2", "--transcript", "t.jsonl"]
     regress = ["regress", "--suite", "tiny.toml", "--results", "r", "--no-progress"]
-    learn = ["learn-weights", "--demos", "d.json", "--method", "per-turn", "--out", "w.toml"]
+    learn = ["learn-weights", "--demos", "d.json", "--method", "per-turn", "--allow-degenerate", "--out", "w.toml"]
     ids = [("ids with a newline", kinds.set_toml(("ids",), ["P01\n", "P02"]))]
     return [
         Kind("study", "study", "study.toml", [status], toml_rules(names=True) + ids),
@@ -101,7 +101,8 @@ PATH_COMMANDS = {
                                      "--transcript", p],
     "view --export": lambda p: ["view", "--export", p, "--seconds", "0"],
     "world show --png": lambda p: ["world", "show", "--png", p],
-    "learn-weights --out": lambda p: ["learn-weights", "--demos", "shipped", "--method", "per-turn", "--out", p],
+    "learn-weights --out": lambda p: ["learn-weights", "--demos", "shipped", "--method", "per-turn",
+                                      "--allow-degenerate", "--out", p],
 }
 SUFFIXES = {"demo --transcript": ".jsonl", "teach --transcript": ".jsonl", "view --export": ".html",
             "world show --png": ".png", "learn-weights --out": ".toml"}

@@ -25,7 +25,8 @@ FILE_OUTPUTS = {
     "teach --transcript": lambda p: ["teach", "--teacher", "scripted", "--turns", "1", "--no-pictures",
                                      "--transcript", p],
     "view --export": lambda p: ["view", "--export", p, "--seconds", "0"],
-    "learn-weights --out": lambda p: ["learn-weights", "--demos", "shipped", "--method", "per-turn", "--out", p],
+    "learn-weights --out": lambda p: ["learn-weights", "--demos", "shipped", "--method", "per-turn",
+                                      "--allow-degenerate", "--out", p],
     "train-questioner --out": lambda p: ["train-questioner", "--out", p, "--steps", "64", "--envs", "1"],
     "world show --png": lambda p: ["world", "show", "--png", p],
 }

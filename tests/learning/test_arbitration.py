@@ -133,7 +133,7 @@ def test_weight_presets_load_and_bad_weights_are_explained(tmp_path):
         resolve_weights({"curiosity": 1.0})
     with pytest.raises(ValueError, match="expected 7 weights"):
         resolve_weights([1.0, 2.0])
-    with pytest.raises(ValueError, match="must be a finite number"):
+    with pytest.raises(ValueError, match="must be a finite real number"):
         resolve_weights({"prediction_margin": float("nan")})
     bad = tmp_path / "bad.toml"
     bad.write_text("[weights]\nprediction_margin = 'high'\n")

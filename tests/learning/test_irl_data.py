@@ -234,7 +234,7 @@ def test_an_npz_with_inconsistent_offsets_is_refused(tmp_path):
 
 # -- the weights file ------------------------------------------------------------------------------------------
 def test_weights_round_trip_through_toml_exactly(tmp_path):
-    values = [0.1, -2.5e-7, 1e300, 0.0, 3.0]
+    values = [0.1, -2.5e-7, 123456.789, 0.0, 3.0]  # within the weights' limit of 1e6 (learning/data/limits.toml)
     provenance = {"method": 'maxent "irl"\n', "iterations": 41, "converged": True, "note": "é\x7f", "l2": 1e-3}
     weights = DecisionWeights(("a", "b_c", "d-e", "f1", "g"), values, provenance)
     path = save_weights(tmp_path / "w.toml", weights, comment="learned from 3 episodes\nsecond line")
@@ -245,7 +245,7 @@ def test_weights_round_trip_through_toml_exactly(tmp_path):
     assert loaded.provenance == provenance
     reordered = load_weights(path, ["g", "a", "b_c", "d-e", "f1"])
     assert reordered.feature_names[0] == "g" and reordered.values[0] == 3.0
-    assert weights.vector(["g", "a", "b_c", "d-e", "f1"]).tolist() == [3.0, 0.1, -2.5e-7, 1e300, 0.0]
+    assert weights.vector(["g", "a", "b_c", "d-e", "f1"]).tolist() == [3.0, 0.1, -2.5e-7, 123456.789, 0.0]
 
 
 @pytest.mark.parametrize("text, message", [
