@@ -42,3 +42,8 @@ class SetupError(TeachbotError, RuntimeError):
 
     Also a ``RuntimeError``, which these were before.
     """
+
+
+class MessageError(TeachbotError):
+    """A message from the browser page (``--web``) is malformed, forged or stale; it is refused and changes
+    nothing."""

@@ -1,0 +1,108 @@
+"""``--web`` for the commands that run a session: the options, and the page, its server and 3D view together.
+
+Wiring, in a command module::
+
+    add_web_options(parser)                          # in register()
+    with WebPage.open(args, environment) as page:    # in run(), when args.web
+        manager, records = open_session(..., teacher=page.teacher, observers=page.observers)
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from dialog.web.server import LOOPBACK, WebServer, check_host, is_loopback
+from dialog.web.teacher import WebTeacher
+from learning.errors import SettingsError
+
+
+def add_web_options(parser: argparse.ArgumentParser, what: str = "answer the robot's questions") -> None:
+    group = parser.add_argument_group("web page")
+    group.add_argument("--web", action="store_true",
+                       help=f"{what} in a browser page instead of the terminal (the URL is printed; 127.0.0.1 only)")
+    group.add_argument("--host", default=LOOPBACK, help="with --web: the address to serve on (default 127.0.0.1; "
+                                                        "another needs --allow-remote)")
+    group.add_argument("--port", type=_port, default=0, help="with --web: the port (default: any free one)")
+    group.add_argument("--allow-remote", action="store_true",
+                       help="with --web: allow --host other than loopback (prints what it exposes; docs/web.md)")
+    group.add_argument("--origin", action="append", default=[], metavar="URL",
+                       help="with --web: a reverse proxy's public address the page may come from, e.g. "
+                            "https://study.example.org (repeatable)")
+
+
+def _port(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a port number from 0 to 65535, got '{text}'") from None
+    if not 0 <= value <= 65535:
+        raise argparse.ArgumentTypeError(f"expected a port number from 0 to 65535, got {value}")
+    return value
+
+
+def check_web_options(args: argparse.Namespace) -> None:
+    """The page's options make sense together (checked before anything starts)."""
+    if not getattr(args, "web", False):
+        given = [name for name, default in (("--host", LOOPBACK), ("--port", 0), ("--allow-remote", False),
+                                            ("--origin", [])) if getattr(args, name[2:].replace("-", "_"),
+                                                                         default) != default]
+        if given:
+            raise SettingsError(f"{', '.join(given)} only go with --web")
+        return
+    check_host(args.host, args.allow_remote)
+
+
+class WebPage:
+    """The page for one session: a :class:`WebTeacher`, the live 3D view (when meshcat starts) and the server."""
+
+    def __init__(self, args: argparse.Namespace, world=None, title: str = "Teaching the robot", out=None,
+                 locate=None, three_d: bool = True):
+        self.out = out or sys.stdout
+        self.teacher = WebTeacher(locate=locate, echo=self.out)
+        self.viewer = None
+        if world is not None and three_d:
+            from dialog.commands._viewer import start_viewer
+
+            self.viewer = start_viewer(argparse.Namespace(viewer=True, viewer_export=getattr(args, "viewer_export",
+                                                                                              None)), world)
+        try:
+            self.server = WebServer(self.teacher, host=args.host, port=args.port, allow_remote=args.allow_remote,
+                                    origins=tuple(args.origin), title=title,
+                                    meshcat_url=getattr(self.viewer, "url", None))
+        except BaseException:
+            self.close_viewer()
+            raise
+        if args.allow_remote and not is_loopback(args.host):
+            print(f"warning: --allow-remote: the page is served on {args.host}:{self.server.port} without TLS. Anyone "
+                  "who can reach it and has the URL (its token) sees the camera pictures, the 3D view and the "
+                  "conversation, and can answer the robot; put it behind a reverse proxy with TLS (docs/web.md)",
+                  file=sys.stderr, flush=True)
+        print(f"Open the page: {self.server.url}", file=self.out, flush=True)
+
+    @property
+    def url(self) -> str:
+        return self.server.url
+
+    @property
+    def observers(self) -> tuple:
+        return (self.viewer, self) if self.viewer is not None else (self,)
+
+    def on_scene(self, scene=None) -> None:
+        """A new scene: tell the page which 3D node is which object, for clicks in the 3D view."""
+        if self.viewer is not None:
+            nodes = {node.rsplit("/", 1)[-1]: index + 1 for index, node in enumerate(self.viewer.reader.object_nodes)}
+            self.teacher.set_nodes(nodes)
+
+    def close_viewer(self) -> None:
+        if self.viewer is not None:
+            from dialog.commands._viewer import stop_viewer
+
+            stop_viewer(self.viewer)
+            self.viewer = None
+
+    def close(self, text: str = "") -> None:
+        """The session is over: the page says so, then the server and the 3D view stop."""
+        self.teacher.end(text)
+        self.server.close()
+        self.close_viewer()
