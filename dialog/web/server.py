@@ -139,6 +139,9 @@ class PictureHandler(_Handler):
 class _Socket(_Checked, tornado.websocket.WebSocketHandler):
     def prepare(self) -> None:
         self.refuse_unless_allowed()
+        if "Origin" not in self.request.headers:  # every browser sends it; a page of this server has this one
+            self.server.log_refusal("a websocket without an Origin")
+            raise tornado.web.HTTPError(403, reason="No origin")
 
     def check_origin(self, origin: str) -> bool:
         if origin in self.server.origins:
