@@ -164,7 +164,7 @@ def _teach(args, settings: SessionSettings, path: Path, lock: TranscriptLock, in
         if args.web and person:  # the page's server and its 3D view (the meshcat mirror)
             from dialog.web.session import WebPage
 
-            page = WebPage(args, environment.world, out=out, locate=environment.picture_pixels)
+            page = WebPage.for_session(args, environment, out=out)
             viewer = page.viewer
         else:
             viewer = start_viewer(args, environment.world)

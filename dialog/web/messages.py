@@ -147,3 +147,35 @@ def _is_whole(value) -> bool:
 def _shown(value) -> str:
     text = json.dumps(value, ensure_ascii=False, default=str)
     return text if len(text) <= 60 else f"{text[:60]}... ({len(text)} characters)"
+
+
+MAX_FREE_TEXT = 2000  # as at the terminal (dialog/study/questionnaire.py)
+
+
+def read_screen(message: dict, screen: dict | None) -> list:
+    """The values a study screen's form gave (None: an item left out), checked against the open ``screen``."""
+    unknown = sorted(set(message) - {"type", "screen", "answers"})
+    if unknown:
+        raise MessageError(f"unknown fields {', '.join(map(_shown, unknown))} in a screen message; accepted: type, "
+                           "screen, answers")
+    if screen is None or message.get("screen") != screen["id"] or isinstance(message.get("screen"), bool):
+        raise MessageError(f"an answer to screen {_shown(message.get('screen'))}; accepted: answers to the screen "
+                           "shown")
+    items, answers = screen.get("items", []), message.get("answers")
+    if not (isinstance(answers, list) and len(answers) == len(items) and all(isinstance(a, str) for a in answers)):
+        raise MessageError(f"screen answers {_shown(answers)}; accepted: one text per item ({len(items)})")
+    values = []
+    for number, (item, answer) in enumerate(zip(items, answers), start=1):
+        if item["kind"] == "likert":
+            if answer == "":
+                values.append(None)
+            elif answer.isdigit() and item["low"] <= int(answer) <= item["high"]:
+                values.append(int(answer))
+            else:
+                raise MessageError(f"item {number}: {_shown(answer)}; accepted: a whole number from {item['low']} "
+                                   f"to {item['high']}, or none")
+        elif len(answer) > MAX_FREE_TEXT:
+            raise MessageError(f"item {number}: a text of {len(answer)} characters; accepted: at most {MAX_FREE_TEXT}")
+        else:
+            values.append(answer.strip() or None)
+    return values

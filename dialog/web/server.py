@@ -207,13 +207,12 @@ class WebServer:
     """The session's page at ``url``, served from a thread of this process until :meth:`close`."""
 
     def __init__(self, teacher, *, host: str = LOOPBACK, port: int = 0, allow_remote: bool = False,
-                 origins: tuple[str, ...] = (), meshcat_url: str | None = None, title: str = "teachbot",
-                 log=None):
+                 origins: tuple[str, ...] = (), title: str = "teachbot", log=None):
         check_host(host, allow_remote)
         self.teacher, self.title, self.log = teacher, title, log or sys.stderr
         self.token = secrets.token_urlsafe(24)
         self.sockets: set[SessionSocket] = set()
-        self.meshcat_socket_url = _meshcat_socket(meshcat_url)
+        self.meshcat_socket_url: str | None = None  # the 3D view's meshcat server, once a kitchen is attached
         try:
             sockets = tornado.netutil.bind_sockets(port, address=host)
         except OSError as error:
@@ -299,7 +298,7 @@ class WebServer:
             self._thread.join(10)
 
 
-def _meshcat_socket(web_url: str | None) -> str | None:
+def meshcat_socket(web_url: str | None) -> str | None:
     """The meshcat server's websocket (``ws://127.0.0.1:PORT/``) from its page URL."""
     if not web_url:
         return None

@@ -12,7 +12,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from dialog.web.server import LOOPBACK, WebServer, check_host, is_loopback
+from dialog.web.server import LOOPBACK, WebServer, check_host, is_loopback, meshcat_socket
 from dialog.web.teacher import WebTeacher
 from learning.errors import SettingsError
 
@@ -54,31 +54,52 @@ def check_web_options(args: argparse.Namespace) -> None:
 
 
 class WebPage:
-    """The page for one session: a :class:`WebTeacher`, the live 3D view (when meshcat starts) and the server."""
+    """The page for one session or one participant's run: a :class:`WebTeacher`, the server, and the live 3D
+    view of the kitchen being taught (``attach``; a study attaches each session's kitchen in turn)."""
 
-    def __init__(self, args: argparse.Namespace, world=None, title: str = "Teaching the robot", out=None,
-                 locate=None, three_d: bool = True):
+    def __init__(self, args: argparse.Namespace, title: str = "Teaching the robot", out=None, three_d: bool = True):
         self.out = out or sys.stdout
-        self.teacher = WebTeacher(locate=locate, echo=self.out)
+        self.args, self.three_d = args, three_d
+        self.teacher = WebTeacher(echo=self.out)
         self.viewer = None
-        if world is not None and three_d:
-            from dialog.commands._viewer import start_viewer
-
-            self.viewer = start_viewer(argparse.Namespace(viewer=True, viewer_export=getattr(args, "viewer_export",
-                                                                                              None)), world)
-        try:
-            self.server = WebServer(self.teacher, host=args.host, port=args.port, allow_remote=args.allow_remote,
-                                    origins=tuple(args.origin), title=title,
-                                    meshcat_url=getattr(self.viewer, "url", None))
-        except BaseException:
-            self.close_viewer()
-            raise
+        self.server = WebServer(self.teacher, host=args.host, port=args.port, allow_remote=args.allow_remote,
+                                origins=tuple(args.origin), title=title)
         if args.allow_remote and not is_loopback(args.host):
             print(f"warning: --allow-remote: the page is served on {args.host}:{self.server.port} without TLS. Anyone "
                   "who can reach it and has the URL (its token) sees the camera pictures, the 3D view and the "
                   "conversation, and can answer the robot; put it behind a reverse proxy with TLS (docs/web.md)",
                   file=sys.stderr, flush=True)
         print(f"Open the page: {self.server.url}", file=self.out, flush=True)
+
+    @classmethod
+    def for_session(cls, args: argparse.Namespace, environment, **options) -> WebPage:
+        page = cls(args, **options)
+        try:
+            page.attach(environment)
+        except BaseException:
+            page.close()
+            raise
+        return page
+
+    def attach(self, environment) -> None:
+        """Show ``environment``'s kitchen: clicks on its camera picture, its 3D view (when meshcat starts)."""
+        self.detach()
+        self.teacher.locate = getattr(environment, "picture_pixels", None)
+        if self.three_d and getattr(environment, "world", None) is not None:
+            from dialog.commands._viewer import start_viewer
+
+            export = getattr(self.args, "viewer_export", None)
+            self.viewer = start_viewer(argparse.Namespace(viewer=True, viewer_export=export), environment.world)
+        self.server.meshcat_socket_url = meshcat_socket(getattr(self.viewer, "url", None))
+        self.teacher.new_view(self.viewer is not None)
+
+    def detach(self) -> None:
+        if self.viewer is not None:
+            from dialog.commands._viewer import stop_viewer
+
+            viewer, self.viewer = self.viewer, None
+            self.server.meshcat_socket_url = None
+            stop_viewer(viewer)
 
     @property
     def url(self) -> str:
@@ -94,15 +115,8 @@ class WebPage:
             nodes = {node.rsplit("/", 1)[-1]: index + 1 for index, node in enumerate(self.viewer.reader.object_nodes)}
             self.teacher.set_nodes(nodes)
 
-    def close_viewer(self) -> None:
-        if self.viewer is not None:
-            from dialog.commands._viewer import stop_viewer
-
-            stop_viewer(self.viewer)
-            self.viewer = None
-
     def close(self, text: str = "") -> None:
         """The session is over: the page says so, then the server and the 3D view stop."""
         self.teacher.end(text)
         self.server.close()
-        self.close_viewer()
+        self.detach()

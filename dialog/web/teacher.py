@@ -19,7 +19,7 @@ import threading
 import numpy as np
 
 from dialog.questions import Prompt, help_text
-from dialog.web.messages import Asked, PageAnswer, decode, read_message
+from dialog.web.messages import Asked, PageAnswer, decode, read_message, read_screen
 from learning.errors import MessageError
 
 CLICK_RADIUS = 0.06  # a click resolves to the nearest object centre within this share of the picture's width
@@ -48,6 +48,11 @@ class WebTeacher:
         self.ended = False
         self.refused = 0
         self.nodes: dict[str, int] = {}
+        self.view = 0  # which 3D view the page shows (a study's next session brings a new one)
+        self.has_view = False
+        self.show_budget = True  # a study hides it from its participants
+        self._screen: dict | None = None  # an open study screen (instructions, pause, questionnaire)
+        self._screen_answers: queue.Queue[list] = queue.Queue()
 
     def options(self) -> dict:
         return {"kind": "terminal"}
@@ -57,7 +62,8 @@ class WebTeacher:
         """Everything a page that (re)connects shows."""
         with self._lock:
             return {"type": "state", "conversation": list(self.conversation), "question": self.current,
-                    "waiting": self._waiting, "ended": self.ended, "nodes": dict(self.nodes)}
+                    "waiting": self._waiting, "ended": self.ended, "nodes": dict(self.nodes),
+                    "screen": self._screen, "view": self.view if self.has_view else 0}
 
     def _post(self, message: dict) -> None:
         self.broadcast(message)
@@ -85,7 +91,8 @@ class WebTeacher:
                 self.pictures[self._question] = prompt.picture
             self.current = {
                 "id": self._question, "turn": prompt.turn, "turns": prompt.turns,
-                "budget_left": prompt.budget_left, "expects": prompt.expects, "text": prompt.text,
+                "budget_left": prompt.budget_left if self.show_budget else None, "expects": prompt.expects,
+                "text": prompt.text,
                 "concepts": list(prompt.concepts), "objects": n_objects,
                 "object": None if prompt.object_index is None else prompt.object_index + 1,
                 "picture": bool(prompt.picture), "details": [line for line in prompt.details
@@ -133,6 +140,14 @@ class WebTeacher:
             print(text, file=self.echo, flush=True)
         self._note("session", text.strip())
 
+    def new_view(self, available: bool) -> None:
+        """A new 3D view (another kitchen's meshcat mirror) for the page to connect to."""
+        with self._lock:
+            self.view += 1
+            self.has_view = available
+            view = self.view if available else 0
+        self._post({"type": "view", "view": view})
+
     def set_nodes(self, nodes: dict[str, int]) -> None:
         """Which 3D-view node is which object (numbered from 1), for clicks in the 3D view."""
         with self._lock:
@@ -145,11 +160,33 @@ class WebTeacher:
             self.ended, self.current, self._asked = True, None, None
         self._post({"type": "ended", "text": text})
 
+    def ask_screen(self, title: str, text: str = "", button: str = "Continue", items: list | None = None) -> list:
+        """Show a study screen (instructions, a pause, the questionnaire) and wait for its form: the values of
+        its ``items`` (None where left out)."""
+        with self._lock:
+            self._question += 1
+            self._screen = {"id": self._question, "title": title, "text": text, "button": button,
+                            "items": list(items or [])}
+            self.current, self._asked = None, None
+            screen = dict(self._screen)
+        self._post({"type": "screen", "screen": screen})
+        while True:
+            try:
+                return self._screen_answers.get(timeout=POLL_S)
+            except queue.Empty:
+                continue
+
     # -- from the server's thread -----------------------------------------------------------------
     def submit(self, raw: str | bytes) -> str | None:
         """Check one message from a page; queue its line. Returns None, or the reason it was refused (logged)."""
         try:
             message = decode(raw)
+            if message.get("type") == "screen":
+                with self._lock:
+                    values = read_screen(message, self._screen)
+                    self._screen = None
+                self._screen_answers.put(values)
+                return None
             with self._lock:
                 if self.ended:
                     raise MessageError("an answer after the session ended; accepted: nothing more")

@@ -11,6 +11,7 @@ let shownAt = 0;         // when this page first showed the open question (for p
 let ended = false;
 let viewer = null;       // the meshcat 3D view, when its script loaded
 let objectNodes = {};    // meshcat node name -> object number (for clicks in the 3D view)
+let view = 0;            // which 3D view is connected (0: none)
 
 function status(text) { $("status").textContent = text; }
 
@@ -38,8 +39,9 @@ function handle(message) {
   if (message.type === "state") {
     $("conversation").replaceChildren();
     message.conversation.forEach(addLine);
-    if (message.screen) { showScreen(message.screen); }
     if (message.question) { showQuestion(message.question); } else { clearQuestion(); }
+    if (message.screen) { showScreen(message.screen); }
+    if (message.view !== view) { start3d(message.view); }
     setWaiting(message.waiting);
     if (message.ended) { showEnded(""); }
     objectNodes = message.nodes || {};
@@ -56,6 +58,8 @@ function handle(message) {
     showScreen(message.screen);
   } else if (message.type === "ended") {
     showEnded(message.text);
+  } else if (message.type === "view") {
+    start3d(message.view);
   } else if (message.type === "nodes") {
     objectNodes = message.nodes;
   }
@@ -90,7 +94,7 @@ function showQuestion(asked) {
   if (fresh) { shownAt = performance.now(); }
   $("screen").hidden = true;
   $("ask").hidden = false;
-  let meta = `Turn ${asked.turn} of ${asked.turns} · budget left ${asked.budget_left}`;
+  let meta = `Turn ${asked.turn} of ${asked.turns}` + (asked.budget_left === null ? "" : ` · budget left ${asked.budget_left}`);
   if (asked.seconds_left !== null) { meta += ` · <span id="countdown">${Math.round(asked.seconds_left)}</span> s to answer`; }
   $("meta").innerHTML = meta;
   if (asked.seconds_left !== null) { countdown(asked.id, asked.seconds_left); }
@@ -216,6 +220,7 @@ function showScreen(screen) {
       return form.querySelector(`[name="item-${i}"]`).value;
     });
     socket.send(JSON.stringify({type: "screen", screen: screen.id, answers}));
+    submit.disabled = true;
   }, true);
   form.appendChild(submit);
   box.appendChild(form);
@@ -255,11 +260,15 @@ $("picture").addEventListener("click", (event) => {
   send({type: "click", x: (event.clientX - box.left) / box.width, y: (event.clientY - box.top) / box.height});
 });
 
-function start3d() {
-  if (typeof MeshCat === "undefined") { return; }
+function start3d(which) {
+  // (re)connect the 3D view: a study's next session brings another kitchen's mirror
+  view = which;
+  $("view3d").replaceChildren();
+  viewer = null;
+  if (!which || typeof MeshCat === "undefined") { return; }
   viewer = new MeshCat.Viewer($("view3d"));
   if (viewer.gui) { viewer.gui.close(); }
-  viewer.connect(`${WS_BASE}/meshcat-ws?token=${encodeURIComponent(TOKEN)}`);
+  viewer.connect(`${WS_BASE}/meshcat-ws?token=${encodeURIComponent(TOKEN)}&view=${which}`);
   viewer.renderer.domElement.addEventListener("click", (event) => {
     if (!question || question.expects !== "demo") { return; }
     const number = objectAt(event);
@@ -301,5 +310,4 @@ $("typed").addEventListener("submit", (event) => {
   send({type: "typed", text});
 });
 
-start3d();
 connect();
