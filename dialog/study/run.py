@@ -189,7 +189,7 @@ class ParticipantRun:
                     self.write("The questionnaire was not finished; it is asked again when the run goes on.")
                     return 0
             questionnaire.save(files.questionnaire, header, answers)
-            self.write(f"Answers saved ({files.questionnaire.name}).")
+            self.write(f"Answers saved ({files.questionnaire.name})." if self.show_conditions else "Answers saved.")
         return None
 
     def teach(self, files, settings: StudySessionSettings, condition, resume: bool) -> bool | None:

@@ -20,8 +20,9 @@ from learning.errors import MessageError
 MAX_MESSAGE_BYTES = 4096
 MAX_TYPED_CHARS = 1000  # the transcript keeps this many characters of a line (dialog/conversation.py)
 COMMANDS = ("why", "undo", "skip", "quit", "help", "don't know", "none")
-KINDS = {"typed": ("text",), "concept": ("concept",), "command": ("command",), "pick": ("object",),
-         "click": ("x", "y"), "features": ("numbers", "mode")}
+KINDS = {"typed": ("text",), "concept": ("concept",), "command": ("command",), "object": ("object",),
+         "pick": ("object",), "click": ("x", "y"), "features": ("numbers", "mode")}
+# "object": an object's number button; "pick": a click on it in the 3D view; "click": on the camera picture
 COMMON = ("type", "question", "page_ms")
 
 
@@ -105,15 +106,15 @@ def _line(kind: str, message: dict, asked: Asked, resolve_click) -> tuple[str, s
             raise MessageError(f"concept {_shown(concept)} for a {asked.expects} question; accepted: "
                                   f"{', '.join(asked.concepts) if asked.expects == 'label' else 'none here'}")
         return concept, "button"
-    if kind in ("pick", "click"):
+    if kind in ("object", "pick", "click"):
         if asked.expects != "demo":
             raise MessageError(f"an object {kind} for a {asked.expects} question; accepted only when asked "
                                   "to show an object")
-        if kind == "pick":
+        if kind in ("object", "pick"):
             number = message.get("object")
             if not (_is_whole(number) and 1 <= number <= asked.n_objects):
                 raise MessageError(f"object {_shown(number)}; accepted: 1 to {asked.n_objects}")
-            return f"number {number}", "click"
+            return f"number {number}", "button" if kind == "object" else "click"
         x, y = message.get("x"), message.get("y")
         if not (_is_number(x) and _is_number(y) and 0 <= x <= 1 and 0 <= y <= 1):
             raise MessageError(f"a click at {_shown(x)}, {_shown(y)}; accepted: x and y from 0 to 1 across "

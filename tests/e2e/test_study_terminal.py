@@ -75,7 +75,7 @@ def test_a_participant_runs_a_session_and_a_questionnaire_at_the_terminal(tmp_pa
     child.expect("> ")
     answer(child, "4", "Anything else?")
     child.expect("> ")
-    answer(child, "it pointed well", "Answers saved (1-ask-questionnaire.jsonl)")
+    answer(child, "it pointed well", "Answers saved.")
     child.expect_exact("Take a short break now.")
     child.sendline("")
     child.expect_exact("=== Session 2 of 2 ===")
@@ -115,7 +115,7 @@ def test_a_participant_runs_a_session_and_a_questionnaire_at_the_terminal(tmp_pa
     child.expect("> ")
     answer(child, "skip", "Anything else?")
     child.expect("> ")
-    answer(child, "", "Answers saved (2-quiet-questionnaire.jsonl)")
+    answer(child, "", "Answers saved.")
     child.expect_exact("T01: all sessions done for now.")
     child.expect(pexpect.EOF)
     child.close()
@@ -145,7 +145,7 @@ def test_participants_see_no_condition_strategy_or_budget_unless_a_pilot_asks(tm
     assert run.returncode == 0, run.stderr
     shown = run.stdout
     assert "=== Session 1 of 2" in shown and "Condition QUIET: the robot may ask once." in shown
-    revealing = ("(quiet)", "(ask)", "active", "budget", "quiet, ask")
+    revealing = ("(quiet)", "(ask)", "active", "budget", "quiet, ask", "quiet-questionnaire")
     if pilot:
         assert "=== Session 1 of 2 (quiet) ===" in shown and "budget left" in shown and "quiet, ask" in shown
     else:

@@ -112,6 +112,15 @@ function showQuestion(asked) {
     answers.appendChild(hint);
     answers.appendChild(button("none here", "n", () => send({type: "command", command: "none"}), true));
     answers.appendChild(button("don't know", "d", () => send({type: "command", command: "don't know"})));
+    const numbers = document.createElement("div");
+    numbers.id = "object-numbers";
+    numbers.setAttribute("aria-label", "Or choose the object by its number");
+    for (let n = 1; n <= asked.objects; n++) {
+      const pick = button(String(n), "", () => send({type: "object", object: n}));
+      pick.setAttribute("aria-label", `object ${n}`);
+      numbers.appendChild(pick);
+    }
+    answers.appendChild(numbers);
   } else if (asked.expects === "feature") {
     answers.appendChild(featureTree(asked.features));
     answers.appendChild(button("use these", "", () => sendFeatures("use"), true));
