@@ -13,7 +13,7 @@ from dialog.study.files import read_transcript_checked, session_files, study_hea
 from dialog.study.status import Cell, study_cells
 
 TURN_COLUMNS = ("participant", "condition", "order", "state", "turn", "action", "cost", "answer", "answer_seconds",
-                "refused", "accuracy")
+                "refused", "accuracy", "channel", "page_seconds")
 ANSWER_COLUMNS = ("participant", "condition", "order", "item", "kind", "value")
 COMMAND_WORDS = frozenset({"help", "?", "why", "more", "undo"})  # lines that ask something rather than answer
 
@@ -23,6 +23,15 @@ def refused_attempts(answer: dict) -> int:
     lines = list(answer.get("lines") or [])
     taken = 1 if answer.get("kind") in ("answer", "absent", "skip", "dont_know") and lines else 0
     return sum(line.strip().lower() not in COMMAND_WORDS for line in lines[:len(lines) - taken])
+
+
+def answer_channel(answer: dict) -> dict:
+    """How the line taken came in a page's session (click, button, typed) and the page's seconds to it; empty for
+    a terminal session."""
+    channels, times = answer.get("channels") or [], answer.get("page_seconds") or []
+    if not channels:
+        return {"channel": None, "page_seconds": None}
+    return {"channel": channels[-1], "page_seconds": times[-1] if times else None}
 
 
 @dataclass
@@ -46,7 +55,8 @@ def collect(study) -> StudyTables:
                 turns.append({**key, "state": cell.state.state, "turn": record["turn"],
                               "action": record["action"]["kind"], "cost": record.get("cost", 0.0),
                               "answer": answer.get("kind", "none"), "answer_seconds": answer.get("seconds", 0.0),
-                              "refused": refused_attempts(answer), "accuracy": record.get("accuracy")})
+                              "refused": refused_attempts(answer), "accuracy": record.get("accuracy"),
+                              **answer_channel(answer)})
         if files.questionnaire.exists():
             for row in questionnaire.load(files.questionnaire)[1]:
                 answers.append({**key, "item": row["item"], "kind": row["kind"], "value": row["value"]})

@@ -3,6 +3,7 @@ files pass ``study status`` and ``study report`` as a terminal session's do."""
 
 from __future__ import annotations
 
+import csv
 import dataclasses
 import subprocess
 from pathlib import Path
@@ -90,4 +91,9 @@ def test_a_participant_does_the_example_study_in_the_browser_with_clicks_only(tm
     report = subprocess.run([TEACHBOT, "study", "report", EXAMPLE, "--folder", folder, "--out", tmp_path / "report"],
                             capture_output=True, text=True, timeout=300)
     assert report.returncode == 0, report.stderr
-    assert (tmp_path / "report" / "report.md").exists()
+    text = (tmp_path / "report" / "report.md").read_text()
+    assert "Answers given in the page" in text and "| page seconds (median) |" in text
+    with open(tmp_path / "report" / "turns.csv") as handle:
+        rows = list(csv.DictReader(handle))
+    assert {row["channel"] for row in rows if row["action"] != "none"} <= {"button", "click"}
+    assert all(float(row["page_seconds"]) >= 0 for row in rows if row["channel"])
