@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+import time
 
 from dialog.web.server import LOOPBACK, WebServer, check_host, is_loopback, meshcat_socket
 from dialog.web.teacher import WebTeacher
@@ -51,6 +52,34 @@ def check_web_options(args: argparse.Namespace) -> None:
             raise SettingsError(f"{', '.join(given)} only go with --web")
         return
     check_host(args.host, args.allow_remote)
+
+
+WAIT_FOR_PAGE_S = 60.0
+
+
+class Watcher:
+    """A dialog observer that shows a scripted episode in the page as it happens (``demo --web``)."""
+
+    def __init__(self, teacher):
+        self.teacher = teacher
+        self.turn = 0
+
+    def on_scene(self, scene=None) -> None:
+        self.teacher.say(f"-- turn {self.turn + 1}: the robot looks at a new scene of "
+                         f"{getattr(scene, 'n_objects', '?')} objects")
+
+    def on_question(self, action, text=None, scene=None) -> None:
+        index = getattr(action, "object_index", None)
+        self.teacher.watch(self.turn + 1, str(getattr(action, "kind", "")), text or "",
+                           None if index is None else int(index) + 1)
+
+    def on_answer(self, action, outcome=None, scene=None) -> None:
+        self.teacher.heard(getattr(outcome, "raw", "") or f"({getattr(outcome, 'kind', 'no answer')})")
+
+    def on_turn(self, record=None, scene=None) -> None:
+        self.turn += 1
+        if isinstance(record, dict) and record.get("action", {}).get("kind") == "none":
+            self.teacher.say(f"Turn {self.turn}: the robot stays quiet.")
 
 
 class WebPage:
@@ -114,6 +143,21 @@ class WebPage:
         if self.viewer is not None:
             nodes = {node.rsplit("/", 1)[-1]: index + 1 for index, node in enumerate(self.viewer.reader.object_nodes)}
             self.teacher.set_nodes(nodes)
+
+    def wait_for_viewer_page(self, timeout_s: float = WAIT_FOR_PAGE_S) -> bool:
+        """Wait until a browser has the page open (a demo should not end before anyone sees it); False if none
+        came within ``timeout_s`` (the episode then goes on anyway)."""
+        print(f"Waiting for a browser to open the page (up to {timeout_s:g} s; Ctrl-C stops)", file=self.out,
+              flush=True)
+        end = time.monotonic() + timeout_s
+        while not self.server.sockets:
+            if time.monotonic() > end:
+                return False
+            time.sleep(0.1)
+        return True
+
+    def watcher(self) -> Watcher:
+        return Watcher(self.teacher)
 
     def close(self, text: str = "") -> None:
         """The session is over: the page says so, then the server and the 3D view stop."""

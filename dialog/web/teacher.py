@@ -127,6 +127,22 @@ class WebTeacher:
             with self._lock:
                 self._waiting = False
 
+    def watch(self, turn: int, kind: str, text: str, number: int | None) -> None:
+        """A scripted episode's question, shown without answer controls (``demo --web``)."""
+        with self._lock:
+            self._question += 1
+            self.current = {"id": self._question, "turn": turn, "turns": None, "budget_left": None,
+                            "expects": kind, "text": text, "object": number, "watch": True, "concepts": [],
+                            "objects": 0, "picture": False, "details": [], "features": [], "seconds_left": None,
+                            "help": ""}
+            question = dict(self.current)
+        self._note("robot", text)
+        self._post({"type": "question", "question": question})
+
+    def heard(self, text: str) -> None:
+        """A scripted teacher's answer, shown as the teacher's line."""
+        self._note("teacher", text)
+
     def answer_channel(self) -> dict:
         last = self._last
         return {"channel": last.channel, "page_seconds": last.page_seconds} if last else {"channel": "typed"}

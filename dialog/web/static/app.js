@@ -94,14 +94,18 @@ function showQuestion(asked) {
   if (fresh) { shownAt = performance.now(); }
   $("screen").hidden = true;
   $("ask").hidden = false;
-  let meta = `Turn ${asked.turn} of ${asked.turns}` + (asked.budget_left === null ? "" : ` · budget left ${asked.budget_left}`);
+  $("typed").hidden = $("commands").hidden = Boolean(asked.watch);  // a demo: watched, not answered
+  let meta = `Turn ${asked.turn}` + (asked.turns ? ` of ${asked.turns}` : "")
+    + (asked.budget_left === null ? "" : ` · budget left ${asked.budget_left}`);
   if (asked.seconds_left !== null) { meta += ` · <span id="countdown">${Math.round(asked.seconds_left)}</span> s to answer`; }
   $("meta").innerHTML = meta;
   if (asked.seconds_left !== null) { countdown(asked.id, asked.seconds_left); }
   $("question-text").textContent = asked.text;
   const answers = $("answers");
   answers.replaceChildren();
-  if (asked.expects === "label") {
+  if (asked.watch) {
+    status(`Turn ${asked.turn}: the scripted teacher answers`);
+  } else if (asked.expects === "label") {
     asked.concepts.forEach((concept, i) => {
       answers.appendChild(button(concept, i < 9 ? String(i + 1) : "", () => send({type: "concept", concept}), true));
     });
