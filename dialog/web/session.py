@@ -27,6 +27,8 @@ def add_web_options(parser: argparse.ArgumentParser, what: str = "answer the rob
     group.add_argument("--port", type=_port, default=0, help="with --web: the port (default: any free one)")
     group.add_argument("--allow-remote", action="store_true",
                        help="with --web: allow --host other than loopback (prints what it exposes; docs/web.md)")
+    group.add_argument("--no-3d", dest="no_3d", action="store_true",
+                       help="with --web: no 3D view, the camera picture only (lighter for a slow machine or browser)")
     group.add_argument("--origin", action="append", default=[], metavar="URL",
                        help="with --web: a reverse proxy's public address the page may come from, e.g. "
                             "https://study.example.org (repeatable)")
@@ -46,8 +48,8 @@ def check_web_options(args: argparse.Namespace) -> None:
     """The page's options make sense together (checked before anything starts)."""
     if not getattr(args, "web", False):
         given = [name for name, default in (("--host", LOOPBACK), ("--port", 0), ("--allow-remote", False),
-                                            ("--origin", [])) if getattr(args, name[2:].replace("-", "_"),
-                                                                         default) != default]
+                                            ("--origin", []), ("--no-3d", False))
+                 if getattr(args, name[2:].replace("-", "_"), default) != default]
         if given:
             raise SettingsError(f"{', '.join(given)} only go with --web")
         return
@@ -88,7 +90,7 @@ class WebPage:
 
     def __init__(self, args: argparse.Namespace, title: str = "Teaching the robot", out=None, three_d: bool = True):
         self.out = out or sys.stdout
-        self.args, self.three_d = args, three_d
+        self.args, self.three_d = args, three_d and not getattr(args, "no_3d", False)
         self.teacher = WebTeacher(echo=self.out)
         self.viewer = None
         self.server = WebServer(self.teacher, host=args.host, port=args.port, allow_remote=args.allow_remote,
