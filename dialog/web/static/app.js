@@ -281,12 +281,21 @@ function start3d(which) {
   if (!which || typeof MeshCat === "undefined") { return; }
   viewer = new MeshCat.Viewer($("view3d"));
   if (viewer.gui) { viewer.gui.close(); }
+  fit3d();
   viewer.connect(`${WS_BASE}/meshcat-ws?token=${encodeURIComponent(TOKEN)}&view=${which}`);
   viewer.renderer.domElement.addEventListener("click", (event) => {
     if (!question || question.expects !== "demo") { return; }
     const number = objectAt(event);
     if (number !== null) { send({type: "pick", object: number}); }
   });
+}
+
+function fit3d() {
+  // meshcat sizes its canvas to the window's height whenever it resizes; here it always takes the page's box
+  if (!viewer) { return; }
+  const resize = viewer.set_3d_pane_size.bind(viewer);
+  viewer.set_3d_pane_size = () => resize($("view3d").clientWidth, $("view3d").clientHeight);
+  viewer.set_3d_pane_size();
 }
 
 function objectAt(event) {
