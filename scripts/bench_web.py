@@ -148,7 +148,7 @@ def main(argv=None) -> int:
     print(f"terminal: Enter to next question  p50 {at_terminal['p50']:.0f} ms  p95 {at_terminal['p95']:.0f} ms  "
           f"max {at_terminal['max']:.0f} ms  (n={at_terminal['n']})")
     print(f"the page adds {overhead:.0f} ms at p95 (goal: under {GOAL_MS:.0f} ms); page load "
-          f"{web['page_load_ms']:.0f} ms (to the first question ready, 3D view included)")
+          f"{web['page_load_ms']:.0f} ms (to the first question ready{', 3D view included' if not args.no_3d else ''})")
     if args.json:
         print(json.dumps(result))
     return 0
