@@ -19,6 +19,7 @@ FEATURE = Asked(6, "feature", CONCEPTS, 12, frozenset({"1", "1.1", "1.2", "2", "
     ({"type": "command", "command": "undo"}, FEATURE, "undo", "button"),
     ({"type": "command", "command": "none"}, DEMO, "none", "button"),
     ({"type": "pick", "object": 12}, DEMO, "number 12", "click"),
+    ({"type": "object", "object": 3}, DEMO, "number 3", "button"),
     ({"type": "typed", "text": "a frut, I think"}, LABEL, "a frut, I think", "typed"),
     ({"type": "features", "numbers": ["1.1", "2"], "mode": "use"}, FEATURE, "1.1, 2", "button"),
     ({"type": "features", "numbers": ["1"], "mode": "ignore"}, FEATURE, "ignore 1", "button"),
