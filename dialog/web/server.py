@@ -61,6 +61,14 @@ def check_host(host: str, allow_remote: bool) -> None:
                             "default), or add --allow-remote (see docs/web.md for a reverse proxy with TLS)")
 
 
+def public_origin(origin: str) -> tuple[str, str]:
+    """The scheme and host of an ``--origin`` (a reverse proxy's public address)."""
+    parts = urlsplit(origin)
+    if parts.scheme not in ("http", "https") or not parts.netloc or parts.path not in ("", "/") or parts.query:
+        raise SettingsError(f"--origin {origin}; accepted: scheme and host only, such as https://study.example.org")
+    return parts.scheme, parts.netloc
+
+
 def meshcat_script() -> Path | None:
     """meshcat's page script (three.js and the viewer), shipped in the meshcat package."""
     try:
@@ -224,12 +232,9 @@ class WebServer:
                                                       if is_loopback(host) else set())
         self.origins = {f"http://{name}" for name in self.hosts}
         for origin in origins:  # a reverse proxy's public address (docs/web.md)
-            parts = urlsplit(origin)
-            if parts.scheme not in ("http", "https") or not parts.netloc or parts.path not in ("", "/"):
-                raise SettingsError(f"--origin {origin}; accepted: scheme and host only, such as "
-                                    "https://study.example.org")
-            self.origins.add(f"{parts.scheme}://{parts.netloc}")
-            self.hosts.add(parts.netloc)
+            scheme, netloc = public_origin(origin)
+            self.origins.add(f"{scheme}://{netloc}")
+            self.hosts.add(netloc)
         self.url = f"http://{shown_host}:{self.port}/?token={self.token}"
         self.refusals = 0
         self._loop: asyncio.AbstractEventLoop | None = None

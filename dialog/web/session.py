@@ -13,7 +13,7 @@ import argparse
 import sys
 import time
 
-from dialog.web.server import LOOPBACK, WebServer, check_host, is_loopback, meshcat_socket
+from dialog.web.server import LOOPBACK, WebServer, check_host, is_loopback, meshcat_socket, public_origin
 from dialog.web.teacher import WebTeacher
 from learning.errors import SettingsError
 
@@ -51,9 +51,11 @@ def check_web_options(args: argparse.Namespace) -> None:
                                             ("--origin", []), ("--no-3d", False))
                  if getattr(args, name[2:].replace("-", "_"), default) != default]
         if given:
-            raise SettingsError(f"{', '.join(given)} only go with --web")
+            raise SettingsError(f"{', '.join(given)} only {'goes' if len(given) == 1 else 'go'} with --web")
         return
     check_host(args.host, args.allow_remote)
+    for origin in args.origin:
+        public_origin(origin)
 
 
 WAIT_FOR_PAGE_S = 60.0
