@@ -7,7 +7,8 @@
 A real ``teachbot teach --web`` session is answered in headless Chromium by
 clicks (a concept button, an object's number button, the feature checkboxes);
 for every answer the time from the click to the next question being shown and
-waiting in the page is measured, and the page's load time (from opening the URL
+waiting in the page is measured (and, of it, the time until the question's
+message reached the browser), and the page's load time (from opening the URL
 to the first question ready to answer, 3D view included). Then the same answers
 are typed into ``teachbot teach`` at a pseudo-terminal, and the time from
 Enter to the next prompt is measured the same way. Both include the robot's own
@@ -55,11 +56,21 @@ def web_session(args, folder: Path) -> dict:
     threading.Thread(target=lambda: [None for _ in process.stdout], daemon=True).start()
     if url is None:
         raise SystemExit("teachbot teach --web printed no URL")
-    times = []
+    times, arrivals, received = [], [], {}
+
+    def watch(socket) -> None:  # when each "waiting" message reaches the browser (its network layer)
+        def frame(payload) -> None:
+            message = json.loads(payload) if isinstance(payload, str) else {}
+            if message.get("type") == "waiting":
+                received[message["question"]] = time.perf_counter()
+        if "/ws?" in socket.url:
+            socket.on("framereceived", frame)
+
     try:
         with sync_playwright() as driver:
             browser = driver.chromium.launch(executable_path=find_chromium(), args=list(CHROMIUM_FLAGS))
             page = browser.new_page(viewport={"width": 1400, "height": 1000})
+            page.on("websocket", watch)
             started = time.perf_counter()
             page.goto(url)
             page.wait_for_function("() => question && waiting", timeout=120_000)
@@ -77,15 +88,17 @@ def web_session(args, folder: Path) -> dict:
                     page.get_by_role("button", name="use these").click()
                 page.wait_for_function("(id) => ended || (question && waiting && question.id !== id)",
                                        arg=question["id"], timeout=120_000, polling=5)
+                shown = time.perf_counter()
                 if page.evaluate("() => ended"):
                     break
-                times.append((time.perf_counter() - clicked) * 1000)
+                times.append((shown - clicked) * 1000)
+                arrivals.append((received.get(page.evaluate("() => question.id"), shown) - clicked) * 1000)
             browser.close()
         process.wait(60)
     finally:
         if process.poll() is None:
             process.kill()
-    return {"click_to_question_ms": times, "page_load_ms": load_ms}
+    return {"click_to_question_ms": times, "click_to_arrival_ms": arrivals, "page_load_ms": load_ms}
 
 
 def terminal_session(args, folder: Path, lines: list[str]) -> list[float]:
@@ -135,16 +148,20 @@ def main(argv=None) -> int:
         _, typed = read_session(folder / "runs/terminal.jsonl")
     same = [r["action"] for r in records] == [r["action"] for r in typed]
     page, at_terminal = summary(web["click_to_question_ms"]), summary(terminal)
+    arrival = summary(web["click_to_arrival_ms"])
     overhead = round(page["p95"] - at_terminal["p95"], 1)
     result = {"turns": args.turns, "seed": args.seed, "strategy": args.strategy, "3d_view": not args.no_3d,
               "same_questions": same,
-              "page_click_to_question_ms": page, "terminal_enter_to_question_ms": at_terminal,
+              "page_click_to_question_ms": page, "page_click_to_arrival_ms": arrival,
+              "terminal_enter_to_question_ms": at_terminal,
               "page_load_ms": round(web["page_load_ms"], 1), "page_p95_overhead_ms": overhead,
               "goal_ms": GOAL_MS, "goal_met": page["p95"] < at_terminal["p95"] + GOAL_MS}
     print(f"{args.turns} turns of {args.strategy}, seed {args.seed}, 3D view {'off' if args.no_3d else 'on'} "
           f"(the same questions at both: {same})")
     print(f"page:     click to next question  p50 {page['p50']:.0f} ms  p95 {page['p95']:.0f} ms  "
           f"max {page['max']:.0f} ms  (n={page['n']})")
+    print(f"          of which until the question reached the browser  p50 {arrival['p50']:.0f} ms  "
+          f"p95 {arrival['p95']:.0f} ms (the rest: the page showing it)")
     print(f"terminal: Enter to next question  p50 {at_terminal['p50']:.0f} ms  p95 {at_terminal['p95']:.0f} ms  "
           f"max {at_terminal['max']:.0f} ms  (n={at_terminal['n']})")
     print(f"the page adds {overhead:.0f} ms at p95 (goal: under {GOAL_MS:.0f} ms); page load "
