@@ -282,12 +282,28 @@ function start3d(which) {
   viewer = new MeshCat.Viewer($("view3d"));
   if (viewer.gui) { viewer.gui.close(); }
   fit3d();
+  throttle3d();
   viewer.connect(`${WS_BASE}/meshcat-ws?token=${encodeURIComponent(TOKEN)}&view=${which}`);
   viewer.renderer.domElement.addEventListener("click", (event) => {
     if (!question || question.expects !== "demo") { return; }
     const number = objectAt(event);
     if (number !== null) { send({type: "pick", object: number}); }
   });
+}
+
+const BUSY_3D_FPS = 3;  // while the robot works: a software-rendering browser would take the cores it needs
+
+function throttle3d() {
+  // meshcat renders on the next animation frame after every change; while the robot is busy (pointing,
+  // deciding), at most BUSY_3D_FPS times a second; while it waits for the answer, freely (orbiting the view)
+  const render = viewer.render.bind(viewer);
+  let last = 0;
+  viewer.render = () => {
+    const now = performance.now();
+    if (!waiting && now - last < 1000 / BUSY_3D_FPS) { viewer.needs_render = true; return; }
+    last = now;
+    render();
+  };
 }
 
 function fit3d() {
