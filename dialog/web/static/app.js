@@ -284,12 +284,24 @@ function start3d(which) {
   fit3d();
   throttle3d();
   viewer.connect(`${WS_BASE}/meshcat-ws?token=${encodeURIComponent(TOKEN)}&view=${which}`);
-  viewer.renderer.domElement.addEventListener("click", (event) => {
-    if (!question || question.expects !== "demo") { return; }
-    const number = objectAt(event);
-    if (number !== null) { send({type: "pick", object: number}); }
-  });
 }
+
+// A click in the 3D view: meshcat's orbit controls take the pointer from the canvas, so the press and the
+// release are watched on the document; one in the same place on the canvas picks the object under it.
+let pressed = null;
+function onCanvas(event) {
+  if (!viewer) { return false; }
+  const box = viewer.renderer.domElement.getBoundingClientRect();
+  return event.clientX >= box.left && event.clientX <= box.right && event.clientY >= box.top && event.clientY <= box.bottom;
+}
+document.addEventListener("pointerdown", (event) => { pressed = onCanvas(event) ? [event.clientX, event.clientY] : null; }, true);
+document.addEventListener("pointerup", (event) => {
+  const still = pressed && onCanvas(event) && Math.hypot(event.clientX - pressed[0], event.clientY - pressed[1]) < 5;
+  pressed = null;
+  if (!still || !question || question.expects !== "demo") { return; }
+  const number = objectAt(event);
+  if (number !== null) { send({type: "pick", object: number}); }
+}, true);
 
 const BUSY_3D_FPS = 3;  // while the robot works: a software-rendering browser would take the cores it needs
 
