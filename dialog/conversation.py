@@ -14,7 +14,7 @@ from typing import Literal, get_args
 
 from dialog.parsing import AnswerParser, Reading
 from dialog.questions import Prompt, help_text
-from dialog.teachers import PreParsedTeacher, Teacher
+from dialog.teachers import PreParsedTeacher, ReportsChannels, Teacher
 
 MAX_RECORDED_CHARS = 1000   # a raw line is cut to this length in the transcript
 MAX_LINES_PER_QUESTION = 200  # then the question counts as skipped (a teacher that only sends noise)
@@ -37,6 +37,7 @@ class Outcome:
     lines: list[str] = field(default_factory=list)
     seconds: float = 0.0
     note: str = ""
+    channels: list[dict] = field(default_factory=list)  # per line, from a teacher that reports them (the page)
 
     @property
     def raw(self) -> str:
@@ -59,6 +60,8 @@ def converse(teacher: Teacher, prompt: Prompt, parser: AnswerParser, clock) -> O
     started = clock.now()
     teacher.show(prompt)
     lines: list[str] = []
+    channels: list[dict] = []
+    reports = isinstance(teacher, ReportsChannels)
     choices: tuple = ()
     while True:
         line = teacher.listen(prompt, prompt.deadline)
@@ -66,15 +69,18 @@ def converse(teacher: Teacher, prompt: Prompt, parser: AnswerParser, clock) -> O
         late = prompt.deadline is not None and now > prompt.deadline
         if line is None:
             return Outcome("late" if late or (prompt.deadline is not None and now >= prompt.deadline) else "quit",
-                           None, lines, now - started, "" if prompt.deadline is not None else "end of input")
+                           None, lines, now - started, "" if prompt.deadline is not None else "end of input",
+                           channels)
         lines.append(line[:MAX_RECORDED_CHARS])
+        if reports:
+            channels.append(teacher.answer_channel())
         if late:
-            return Outcome("late", None, lines, now - started)
+            return Outcome("late", None, lines, now - started, channels=channels)
         reading = parser.choice(line, choices) if choices else read_line(prompt, parser, line)
         if len(lines) >= MAX_LINES_PER_QUESTION and reading.kind in ("help", "why", "more", "unreadable", "reject",
                                                                     "choose"):
             teacher.tell(f"({len(lines)} answers without one I could take: I'll skip this question.)")
-            return Outcome("skip", None, lines, clock.now() - started, "too many unreadable answers")
+            return Outcome("skip", None, lines, clock.now() - started, "too many unreadable answers", channels)
         if reading.kind == "more":  # a group of the feature list opened: a reply, the question stays open
             teacher.tell(reading.message)
         elif reading.kind == "help":
@@ -96,4 +102,4 @@ def converse(teacher: Teacher, prompt: Prompt, parser: AnswerParser, clock) -> O
             note = reading.message if reading.kind == "answer" else ""
             if note.startswith("("):  # a typo read as a concept: say so, so that the teacher can undo it
                 teacher.tell(note)
-            return Outcome(reading.kind, reading.value, lines, clock.now() - started, note)
+            return Outcome(reading.kind, reading.value, lines, clock.now() - started, note, channels)

@@ -166,6 +166,14 @@ class SimulatedKitchen:
         regions = {name: view.pixels(location_corners(location)) for name, location in self.locations.items()}
         self._scene_image = (scene.scene_id, view.rgb, view.pixels(scene.positions), regions)
 
+    def picture_pixels(self, scene: Scene) -> tuple[np.ndarray, int, int]:
+        """Each object's pixel (column, row) in the scene picture, and the picture's width and height (the page
+        resolves a click on the picture to an object with these, dialog/web/teacher.py)."""
+        if self._scene_image is None or self._scene_image[0] != scene.scene_id:
+            self._capture(scene)
+        _, rgb, pixels, _ = self._scene_image
+        return np.asarray(pixels, dtype=float), int(rgb.shape[1]), int(rgb.shape[0])
+
     def scene_picture(self, scene: Scene, path: str | Path, highlight: int | None = None) -> Path:
         """Write the scene's camera image as the teacher sees it (the robot at the top), with every object's
         number (``highlight`` ringed) and the kitchen's locations, to ``path``."""

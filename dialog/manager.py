@@ -326,10 +326,11 @@ class DialogManager:
 
     def _ask(self, prompt: Prompt) -> tuple[Outcome, list[int]]:
         """Converse until the question ends; "undo" takes back earlier answers (applied once it ends)."""
-        lines, undone = [], []
+        lines, channels, undone = [], [], []
         while True:
             outcome = converse(self.teacher, prompt, self.parser, self.clock)
             lines += outcome.lines
+            channels += outcome.channels
             if outcome.kind != "undo":
                 break
             if len(undone) >= len(self._undo_stack):
@@ -338,7 +339,7 @@ class DialogManager:
             turn, what = self._undo_stack[-1 - len(undone)][:2]
             undone.append(turn)
             self.teacher_tell(f"Taken back: {what} (turn {turn}). {prompt.text}")
-        outcome.lines = lines
+        outcome.lines, outcome.channels = lines, channels
         return outcome, undone
 
     def teacher_tell(self, text: str) -> None:

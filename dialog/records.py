@@ -21,6 +21,7 @@ from learning.actions import Action, DemoQuery, FeatureQuery, LabelQuery, NoQuer
 from learning.errors import TranscriptError
 
 ANSWER_KINDS = ("answer", "absent", "skip", "dont_know", "late", "none")
+CHANNELS = ("typed", "button", "click")  # how a page's answer line came (dialog/web/messages.py makes them)
 
 
 def action_record(action: Action) -> dict:
@@ -64,6 +65,9 @@ def answer_record(outcome: Outcome, action: Action, feature_names) -> dict:
               "lines": list(outcome.lines), "seconds": round(float(outcome.seconds), 3)}
     if outcome.note:
         record["note"] = outcome.note
+    if outcome.channels:  # only a page's answers say how each line came (terminal transcripts stay as they were)
+        record["channels"] = [entry["channel"] for entry in outcome.channels]
+        record["page_seconds"] = [entry.get("page_seconds") for entry in outcome.channels]
     return record
 
 
@@ -174,6 +178,13 @@ def _check_answer(answer, action: str, concepts, feature_names) -> None:
     seconds = answer.get("seconds", 0.0)
     if not (_is_number(seconds) and seconds >= 0):
         raise _refuse("answer.seconds", seconds, "zero or more seconds")
+    if "channels" in answer:  # a page's session: how each line came, and the page's answer time
+        channels, times = answer["channels"], answer.get("page_seconds", [])
+        if not (isinstance(channels, list) and len(channels) == len(lines) and all(c in CHANNELS for c in channels)):
+            raise _refuse("answer.channels", channels, f"one of {', '.join(CHANNELS)} for each line")
+        if not (isinstance(times, list) and len(times) == len(lines)
+                and all(t is None or (_is_number(t) and t >= 0) for t in times)):
+            raise _refuse("answer.page_seconds", times, "null or zero or more seconds for each line")
 
 
 def _check_model(model, concepts) -> None:

@@ -196,10 +196,11 @@ def session_teacher(settings: SessionSettings, rngs, clock, input_stream=None, o
 
 def open_session(settings: SessionSettings, environment, transcript_path: str | Path, *, resume: bool = False,
                  pictures: str | None = None, input_stream=None, output_stream=None, say=None,
-                 observers=(), lock=None) -> tuple[DialogManager, list[dict]]:
+                 observers=(), lock=None, teacher=None) -> tuple[DialogManager, list[dict]]:
     """The manager for a new session, or for a recorded one with its turns already replayed (they come back too).
 
     ``lock`` is the transcript's :class:`TranscriptLock` when the caller took it already (one writer per file).
+    ``teacher`` stands in for the settings' person (the page of ``--web``); its ``clock`` is set to the session's.
 
     Resuming checks every recorded turn, then replays it against the rebuilt
     episode; a malformed or diverging record is refused as ``FILE: line N: ...``.
@@ -218,7 +219,10 @@ def open_session(settings: SessionSettings, environment, transcript_path: str | 
             start = float(numbered[-1][1].get("ended", numbered[-1][1].get("time", 0.0)))
     rngs = episode_generators(settings.seed)
     clock = make_clock(settings, start)
-    teacher = session_teacher(settings, rngs, clock, input_stream, output_stream)
+    if teacher is None:
+        teacher = session_teacher(settings, rngs, clock, input_stream, output_stream)
+    elif getattr(teacher, "clock", False) is None:
+        teacher.clock = clock
     transcript = TranscriptWriter(transcript_path, append=resume, lock=lock)
     manager = DialogManager(environment, teacher, settings.build_strategy(), settings.config(pictures),
                             transcript, rngs, say=say or print, observers=observers, clock=clock,

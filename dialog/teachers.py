@@ -58,6 +58,14 @@ class FastForwards(Protocol):
 
 
 @runtime_checkable
+class ReportsChannels(Protocol):
+    """A teacher whose lines come by different ways (the page: click, button, typed): after each ``listen``,
+    ``answer_channel()`` says how that line came, ``{"channel": ..., "page_seconds": ...}``."""
+
+    def answer_channel(self) -> dict: ...
+
+
+@runtime_checkable
 class AnswersParsed(Protocol):
     """An older-style teacher that answers with a parsed value."""
 

@@ -84,6 +84,7 @@ class TerminalTeacher:
         self.clock = clock
         self._missed = False
         self._shown: Prompt | None = None  # the question on screen: asked again (after undo), not reprinted
+        self.show_budget = True  # a study hides the budget from its participants (dialog/study/run.py)
 
     def options(self) -> dict:
         return {"kind": "terminal"}
@@ -98,7 +99,9 @@ class TerminalTeacher:
             return  # asked again after an undo: "Taken back: ..." already repeated the question
         self._shown = prompt
         self.console.print()
-        status = f"Turn {prompt.turn} of {prompt.turns} · budget left {prompt.budget_left:g}"
+        status = f"Turn {prompt.turn} of {prompt.turns}"
+        if self.show_budget:
+            status += f" · budget left {prompt.budget_left:g}"
         if prompt.deadline is not None and self.clock is not None:
             status += f" · {max(0.0, prompt.deadline - self.clock.now()):.0f} s to answer"
         self.console.print(status, style="dim")

@@ -46,6 +46,11 @@ class SetupError(TeachbotError, RuntimeError):
     """
 
 
+class MessageError(TeachbotError):
+    """A message from the browser page (``--web``) is malformed, forged or stale; it is refused and changes
+    nothing."""
+
+
 def did_you_mean(text: str, names) -> str:
     """" (did you mean 'dt-task'?)" when ``text`` is close to one of ``names`` (the closest), else "": the hint
     an unknown name's message carries."""

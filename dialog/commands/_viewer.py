@@ -137,3 +137,44 @@ def viewer_observers(args: argparse.Namespace, world):
         yield (viewer,) if viewer is not None else ()
     finally:
         stop_viewer(viewer)
+
+
+DEFAULT_PACE_S = 1.5  # seconds a turn lasts at least when someone watches (--viewer, --web), so they can follow
+
+
+class Pacer:
+    """A dialog observer that makes each turn last at least ``seconds`` of wall time (``--pace``).
+
+    It only waits: the episode, its clock and its transcript are the same with any pace. It goes first among
+    the observers, so that a question is shown (viewer, page) once its wait is over.
+    """
+
+    def __init__(self, seconds: float):
+        self.seconds = float(seconds)
+        self._turn_started: float | None = None
+
+    def on_scene(self, scene=None) -> None:
+        if self._turn_started is None:  # the first turn begins (building the held-out set came before)
+            self._turn_started = time.monotonic()
+
+    def on_question(self, action=None, text=None, scene=None) -> None:
+        self._wait(0.5)  # the question is on the page before its answer comes
+
+    def on_turn(self, record=None, scene=None) -> None:
+        self._wait(1.0)
+        self._turn_started = time.monotonic()
+
+    def _wait(self, share: float) -> None:
+        if self._turn_started is None:
+            self._turn_started = time.monotonic()
+        left = self._turn_started + share * self.seconds - time.monotonic()
+        if left > 0:
+            time.sleep(left)
+
+
+def pace_of(args: argparse.Namespace) -> float:
+    """``--pace``, or its default: DEFAULT_PACE_S when the episode is watched (--viewer, --web), else 0."""
+    if getattr(args, "pace", None) is not None:
+        return float(args.pace)
+    watched = bool(getattr(args, "viewer", False) or getattr(args, "web", False))
+    return DEFAULT_PACE_S if watched else 0.0

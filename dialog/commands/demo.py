@@ -9,8 +9,9 @@ from pathlib import Path
 
 from dialog.clock import VirtualClock
 from dialog.commands._arguments import add_episode_options, add_time_options, resolve_time
+from dialog.commands._arguments import seconds as seconds_type
 from dialog.commands._summary import questions_in_words, scene_size
-from dialog.commands._viewer import add_viewer_option, hold_viewer, viewer_observers
+from dialog.commands._viewer import DEFAULT_PACE_S, Pacer, add_viewer_option, hold_viewer, pace_of, viewer_observers
 from dialog.commands.teach import DEFAULT_STRATEGY
 from dialog.environment import SimulatedKitchen
 from dialog.experiments.runner import file_label
@@ -21,6 +22,7 @@ from dialog.teachers import OracleTeacher
 from dialog.transcript import FORMAT, TranscriptWriter
 from dialog.transcript_lock import TranscriptLock
 from dialog.user_weights import WEIGHTS_STRATEGY_NAME, add_weights_option, weights_strategy
+from dialog.web.session import add_web_options, check_web_options
 from learning.errors import TranscriptError
 from learning.strategies import STRATEGY_NAMES, make_strategy
 
@@ -40,6 +42,10 @@ def register(commands) -> None:
                              "task, kitchen or --embodied-costs adds itself to the name)")
     add_weights_option(parser)
     add_viewer_option(parser)
+    parser.add_argument("--pace", type=seconds_type, default=None, metavar="SECONDS",
+                        help=f"each turn lasts at least SECONDS of wall time, so a person can follow (default "
+                             f"{DEFAULT_PACE_S:g} with --viewer or --web, else 0); the transcript is the same")
+    add_web_options(parser, "watch the episode turn by turn")
     parser.add_argument("--json", action="store_true", help="end with one JSON line summarising the episode")
     parser.set_defaults(handler=run)
 
@@ -75,6 +81,7 @@ def default_transcript(args: argparse.Namespace, seconds: float | None) -> Path:
 
 
 def run(args: argparse.Namespace) -> int:
+    check_web_options(args)
     turns, seconds = resolve_time(args)
     args.strategy, weights = weights_strategy(args.strategy, args.weights)  # --weights: DT shown as "dt"
     strategy = make_strategy(args.strategy) if weights is None else weights.strategy(WEIGHTS_STRATEGY_NAME)
@@ -96,15 +103,17 @@ def run(args: argparse.Namespace) -> int:
     try:
         refuse_foreign_transcript(transcript_path, lock)
         environment = SimulatedKitchen(task=args.task, kitchen=args.kitchen, seed=args.seed, joint_speed=joint_speed)
+        pace = pace_of(args)
         try:
-            with viewer_observers(args, environment.world) as observers:
-                with TranscriptWriter(transcript_path, lock=lock) as transcript:
-                    teacher = OracleTeacher(rngs["teacher"], clock=clock, answer_delays=delays)
-                    manager = DialogManager(environment, teacher, strategy, config, transcript, rngs,
-                                            observers=observers, session=session, clock=clock)
-                    result = manager.run()
-                _print_summary(args, result, environment, manager)
-                hold_viewer(args, observers[0] if observers else None)
+            if args.web:
+                _watch_in_page(args, environment, pace, lambda observers: _episode(
+                    args, environment, strategy, config, transcript_path, lock, rngs, clock, delays, session,
+                    observers))
+            else:
+                with viewer_observers(args, environment.world) as observers:
+                    _episode(args, environment, strategy, config, transcript_path, lock, rngs, clock, delays,
+                             session, ((Pacer(pace),) if pace > 0 else ()) + observers)
+                    hold_viewer(args, observers[0] if observers else None)
         finally:
             environment.close()
     finally:
@@ -112,15 +121,39 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
+def _episode(args, environment, strategy, config, transcript_path, lock, rngs, clock, delays, session, observers):
+    with TranscriptWriter(transcript_path, lock=lock) as transcript:
+        teacher = OracleTeacher(rngs["teacher"], clock=clock, answer_delays=delays)
+        manager = DialogManager(environment, teacher, strategy, config, transcript, rngs,
+                                observers=observers, session=session, clock=clock)
+        result = manager.run()
+    return _print_summary(args, result, environment, manager)
+
+
+def _watch_in_page(args, environment, pace: float, play) -> None:
+    """``demo --web``: the page shows the scripted episode as it happens, once a browser has opened it."""
+    from dialog.web.session import WebPage
+
+    page = WebPage.for_session(args, environment, title="teachbot demo")
+    try:
+        page.wait_for_viewer_page()
+        summary = play((*((Pacer(pace),) if pace > 0 else ()), *page.observers, page.watcher()))
+        page.teacher.end(summary)
+    finally:
+        page.close()
+
+
 def _print_summary(args: argparse.Namespace, result, environment, manager) -> None:
     used = "" if manager.embodied is None else \
         f"time used {manager.clock.now():.0f} of {manager.config.seconds:g} s in {result.completed} turns; "
-    print(f"\nAccuracy on {args.task} held-out scenes: {result.accuracy:.1%} "
-          f"(chance {1 / len(environment.concepts):.0%}); budget spent {result.budget_spent:g} of {args.budget:g}; "
-          f"questions: {questions_in_words(result.queries)}; {scene_size(environment.world.task)}; "
-          f"{used}{result.seconds:.1f} s. "
-          f"Transcript: {result.transcript}", flush=True)
+    line = (f"Accuracy on {args.task} held-out scenes: {result.accuracy:.1%} "
+            f"(chance {1 / len(environment.concepts):.0%}); budget spent {result.budget_spent:g} of {args.budget:g}; "
+            f"questions: {questions_in_words(result.queries)}; {scene_size(environment.world.task)}; "
+            f"{used}{result.seconds:.1f} s. "
+            f"Transcript: {result.transcript}")
+    print(f"\n{line}", flush=True)
     if args.json:
         summary = {key: asdict(result)[key] for key in SUMMARY_KEYS}
         summary["queries"] = {kind: summary["queries"][kind] for kind in ("label", "demo", "feature", "none")}
         print(json.dumps(summary), flush=True)
+    return line

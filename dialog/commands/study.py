@@ -25,6 +25,12 @@ def register(subparsers) -> None:
     run.add_argument("--abort", default=None, metavar="REASON",
                      help="mark the participant's current session aborted with REASON (it stays in the record)")
     run.add_argument("--no-viewer", action="store_true", help="no meshcat viewer, whatever the conditions say")
+    run.add_argument("--show-conditions", action="store_true",
+                     help="show the participant the condition names, the order and the budgets (for a pilot; by "
+                          "default they see 'Session 1 of 3' and the instructions only)")
+    from dialog.web.session import add_web_options
+
+    add_web_options(run, "the participant answers")
     run.set_defaults(handler=_run)
 
     status = actions.add_parser(
@@ -76,15 +82,34 @@ def _load(args):
 def _run(args) -> int:
     from dialog.commands._resume import continue_command
     from dialog.study.run import ParticipantRun
+    from dialog.web.session import check_web_options
+    from learning.errors import SettingsError
 
+    check_web_options(args)
+    if args.web and (args.simulated or args.abort is not None):
+        raise SettingsError(f"--web is for a participant answering in the page; not with "
+                            f"{'--simulated' if args.simulated else '--abort'}")
     study = _load(args)
     again = continue_command(["teachbot", "study", "run", args.study, "--participant", args.participant], args,
                              RUN_OPTIONS)
-    runner = ParticipantRun(study, args.participant, args.simulated, viewer=False if args.no_viewer else None,
+    viewer = False if args.no_viewer else None
+    if args.abort is not None or not args.web:
+        runner = ParticipantRun(study, args.participant, args.simulated, viewer=viewer,
+                                show_conditions=args.show_conditions, continue_command=again)
+        return runner.abort(args.abort) if args.abort is not None else runner.run(args.condition, args.again)
+    from dialog.web.session import WebPage
+
+    runner = ParticipantRun(study, args.participant, False, viewer=viewer, show_conditions=args.show_conditions,
                             continue_command=again)
-    if args.abort is not None:
-        return runner.abort(args.abort)
-    return runner.run(args.condition, args.again)
+    if not args.again:
+        runner.plan(args.condition, False)  # refuses a participant already done before the page opens
+    page = WebPage(args, title=f"Study '{study.name}'")
+    try:
+        runner.page = page
+        page.teacher.show_budget = args.show_conditions
+        return runner.run(args.condition, args.again)
+    finally:
+        page.close()
 
 
 def _status(args) -> int:

@@ -18,6 +18,7 @@ from dialog.session import TEACHERS, SessionSettings, open_session
 from dialog.transcript import read_session
 from dialog.transcript_lock import TranscriptLock
 from dialog.user_weights import add_weights_option, weights_strategy
+from dialog.web.session import add_web_options, check_web_options
 from learning.errors import OutputPathError, SettingsError, TranscriptError
 from learning.strategies import STRATEGY_NAMES
 
@@ -68,6 +69,7 @@ def register(commands) -> None:
                         help="never fetch an absent example from the pantry")
     add_weights_option(parser)
     add_viewer_option(parser)
+    add_web_options(parser)
     parser.add_argument("--json", action="store_true", help="end with one JSON line summarising the session")
     parser.set_defaults(handler=run)
 
@@ -136,6 +138,9 @@ def _picture_folder(args, path: Path, person: bool) -> Path | None:
 
 
 def run(args: argparse.Namespace, input_stream=None, output_stream=None) -> int:
+    check_web_options(args)
+    if args.web and args.teacher != "terminal":
+        raise SettingsError(f"--web is for a person answering in the page; not with --teacher {args.teacher}")
     settings, path, lock = _claim_transcript(args)
     try:
         return _teach(args, settings, path, lock, input_stream, output_stream)
@@ -154,13 +159,21 @@ def _teach(args, settings: SessionSettings, path: Path, lock: TranscriptLock, in
         joint_speed = load_embodied_costs().joint_speed
     environment = SimulatedKitchen(task=settings.task, kitchen=settings.kitchen, seed=settings.seed,
                                    pictures=pictures is not None, joint_speed=joint_speed)
-    viewer = None
+    viewer = page = None
     try:
-        viewer = start_viewer(args, environment.world)
+        if args.web and person:  # the page's server and its 3D view (the meshcat mirror)
+            from dialog.web.session import WebPage
+
+            page = WebPage.for_session(args, environment, out=out)
+            viewer = page.viewer
+        else:
+            viewer = start_viewer(args, environment.world)
+        observers = page.observers if page is not None else () if viewer is None else (viewer,)
         manager, records = open_session(settings, environment, path, resume=args.resume is not None,
                                         pictures=None if pictures is None else str(pictures),
                                         input_stream=input_stream, output_stream=out, say=None,
-                                        observers=() if viewer is None else (viewer,), lock=lock)
+                                        observers=observers, lock=lock,
+                                        teacher=None if page is None else page.teacher)
         manager.say = _narrator(manager.teacher, out, person)
         allocation = f"{settings.turns} turns" if settings.seconds is None else \
             f"{settings.seconds:g} s with embodied costs (at most {settings.turns} turns)"
@@ -205,9 +218,13 @@ def _teach(args, settings: SessionSettings, path: Path, lock: TranscriptLock, in
                               "completed": result.completed, "quit": result.quit, "budget_spent": result.budget_spent,
                               "queries": result.queries, "accuracy": round(result.accuracy, 6),
                               "transcript": str(path), "seconds": round(result.seconds, 3)}), file=out, flush=True)
-        hold_viewer(args, viewer, input_stream)
+        if page is None:
+            hold_viewer(args, viewer, input_stream)
     finally:
-        stop_viewer(viewer)
+        if page is not None:
+            page.close()
+        else:
+            stop_viewer(viewer)
         environment.close()
     return 0
 

@@ -54,6 +54,17 @@ def ask_terminal(items, read_line, write) -> list[dict] | None:
     return answers
 
 
+def ask_web(items, teacher) -> list[dict]:
+    """Each item's answer from the page's form (``dialog.web.teacher.WebTeacher.ask_screen``): Likert items as
+    radio buttons, free text as a text box; an item left empty is left out."""
+    shown = [{"kind": "likert", "text": item.text, "low": 1, "high": item.points, "low_label": item.anchors[0],
+              "high_label": item.anchors[1]} if item.kind == "likert" else {"kind": "text", "text": item.text}
+             for item in items]
+    values = teacher.ask_screen("A few questions about this session", "Leave an item empty to leave it out.",
+                                "Save the answers", shown)
+    return [{"item": item.id, "kind": item.kind, "value": value} for item, value in zip(items, values)]
+
+
 def ask_simulated(items, rng) -> list[dict]:
     """A simulated participant's answers: Likert values around the middle of the scale, a fixed free text."""
     answers = []

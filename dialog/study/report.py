@@ -169,6 +169,7 @@ def report_lines(study, tables, sessions, final, figures) -> list[str]:
                      sum(r["refused"] for r in asked)])
     lines += _table(["condition", "n", "final accuracy (mean)", "sd", "questions per session label/demo/feature/none",
                      "answer seconds (mean)", "refused answers"], rows)
+    lines += channel_lines(tables, names)
     lines += ["", f"![learning curves]({figures[0].name})", "", f"![final accuracy]({figures[1].name})", ""]
     lines += questionnaire_lines(study, tables, names)
     likert = _likert_values(study, tables)
@@ -190,6 +191,23 @@ def _likert_values(study, tables) -> dict:
         if row["item"] in values and row["value"] is not None and (row["participant"], row["condition"]) in done:
             values[row["item"]][row["condition"]][row["participant"]] = float(row["value"])
     return values
+
+
+def channel_lines(tables, names) -> list[str]:
+    """Per condition, how the answers taken came in the page's sessions (``--web``), and the page's answer times;
+    nothing when every session was at the terminal."""
+    rows = []
+    for name in names:
+        taken = [r for r in tables.turns if r["condition"] == name and r.get("channel")]
+        if taken:
+            seconds = [r["page_seconds"] for r in taken if r.get("page_seconds") is not None]
+            counts = [sum(r["channel"] == channel for r in taken) for channel in ("click", "button", "typed")]
+            rows.append([name, len(taken), *counts, _fmt(float(np.median(seconds)) if seconds else None)])
+    if not rows:
+        return []
+    return ["", "Answers given in the page (`--web`): how each answer taken came, and the seconds from the question "
+                "being shown in the page to it (median).", ""] + _table(
+        ["condition", "answers", "click", "button", "typed", "page seconds (median)"], rows)
 
 
 def questionnaire_lines(study, tables, names) -> list[str]:

@@ -58,7 +58,8 @@ class ParticipantRun:
     """The terminal side of one participant's run: what they read, what they type, and the files it writes."""
 
     def __init__(self, study, participant: str, simulated: bool, input_stream=None, output_stream=None,
-                 viewer: bool | None = None, continue_command: str | None = None):
+                 viewer: bool | None = None, continue_command: str | None = None, show_conditions: bool = False,
+                 page=None):
         self.study, self.participant, self.simulated = study, study.check_participant(participant), simulated
         self.order = assigned_orders(study)[participant]
         self.input_stream = input_stream if input_stream is not None else sys.stdin
@@ -68,6 +69,10 @@ class ParticipantRun:
         self.continue_command = continue_command or shlex.join(  # what the "continue with" line says
             ["teachbot", "study", "run", str(study.path), "--participant", participant]
             + (["--simulated"] if simulated else []))
+        self.show_conditions = show_conditions  # condition names, strategies, budgets: for a pilot only
+        self.page = page  # a dialog.web.session.WebPage: the participant answers in the browser
+        if page is not None:
+            page.teacher.show_budget = show_conditions
 
     def write(self, text: str, end: str = "\n") -> None:
         print(text, end=end, file=self.out, flush=True)
@@ -143,16 +148,22 @@ class ParticipantRun:
     def run(self, only: str | None = None, again: bool = False) -> int:
         positions = self.plan(only, again)
         check_writable(self.study.folder / self.participant, "participant's folder", folder=True)
-        self.write(f"Study '{self.study.name}', participant {self.participant}: {len(self.order)} sessions in the "
-                   f"order {', '.join(self.order)}; {len(positions)} to run now.")
+        order = f" in the order {', '.join(self.order)}" if self.show_conditions else ""
+        self.write(f"Study '{self.study.name}', participant {self.participant}: {len(self.order)} sessions{order}; "
+                   f"{len(positions)} to run now.")
         for count, position in enumerate(positions):
             if count and not self.simulated:
                 self.write(f"\n{self.study.pause}")
-                self.read_line()
+                if self.page is not None:
+                    self.page.teacher.ask_screen("A short break", self.study.pause, "Go on")
+                else:
+                    self.read_line()
             stopped = self.run_one(position)
             if stopped is not None:
                 return stopped
         self.write(f"{self.participant}: all sessions done for now. Thank you!")
+        if self.page is not None:
+            self.page.teacher.end("All sessions are done. Thank you!")
         return 0
 
     def run_one(self, position: int) -> int | None:
@@ -164,12 +175,18 @@ class ParticipantRun:
         state = session_state_of(self.study, self.participant, position, name)
         if state.state == "damaged":
             self._refuse_damaged(position, state)
-        self.write(f"\n=== Session {position} of {len(self.order)} ({name}) ===")
+        title = f"Session {position} of {len(self.order)}" + (f" ({name})" if self.show_conditions else "")
+        self.write(f"\n=== {title} ===")
         if state.state in ("missing", "running"):
             self.write(condition.instructions.strip())
-            if state.state == "running":
-                self.write(f"(This session was interrupted after {state.turns_done} turns; it goes on from there.)")
-            if not self.simulated:
+            interrupted = (f"(This session was interrupted after {state.turns_done} turns; it goes on from there.)"
+                           if state.state == "running" else "")
+            if interrupted:
+                self.write(interrupted)
+            if self.page is not None:
+                self.page.teacher.ask_screen(title, "\n".join(filter(None, (condition.instructions.strip(),
+                                                                              interrupted))), "Begin")
+            elif not self.simulated:
                 self.write("Press Enter to begin.")
                 self.read_line()
             finished = self.teach(files, settings, condition, resume=state.state == "running")
@@ -184,13 +201,15 @@ class ParticipantRun:
             if self.simulated:
                 answers = questionnaire.ask_simulated(self.study.items, questionnaire_rng(self.study, self.participant,
                                                                                           name))
+            elif self.page is not None:
+                answers = questionnaire.ask_web(self.study.items, self.page.teacher)
             else:
                 answers = questionnaire.ask_terminal(self.study.items, self.read_line, self.write)
                 if answers is None:
                     self.write("The questionnaire was not finished; it is asked again when the run goes on.")
                     return 0
             questionnaire.save(files.questionnaire, header, answers)
-            self.write(f"Answers saved ({files.questionnaire.name}).")
+            self.write(f"Answers saved ({files.questionnaire.name})." if self.show_conditions else "Answers saved.")
         return None
 
     def teach(self, files, settings: StudySessionSettings, condition, resume: bool) -> bool | None:
@@ -221,14 +240,20 @@ class ParticipantRun:
             from dialog.commands._viewer import start_viewer, stop_viewer
 
             want_viewer = condition.viewer if self.viewer is None else self.viewer
-            if want_viewer and person:
+            if self.page is not None:  # the page shows this session's kitchen (its 3D view unless --no-viewer)
+                self.page.three_d = self.viewer is not False
+                self.page.attach(environment)
+            elif want_viewer and person:
                 viewer = start_viewer(argparse.Namespace(viewer=True, viewer_export=None), environment.world)
+            observers = self.page.observers if self.page is not None else () if viewer is None else (viewer,)
             manager, records = open_session(settings, environment, files.transcript, resume=resume,
                                             pictures=None if pictures is None else str(pictures),
                                             input_stream=self.input_stream, output_stream=self.out,
-                                            observers=() if viewer is None else (viewer,), lock=lock)
-            if person:
+                                            observers=observers, lock=lock,
+                                            teacher=None if self.page is None else self.page.teacher)
+            if person and self.page is None:
                 manager.teacher.reader = self.reader  # one reader for the whole run: nothing typed is lost
+                manager.teacher.show_budget = self.show_conditions
                 self.write("Type 'help' at any question for what you can answer; 'why' asks the robot's reason, "
                            "'undo' takes back your last answer, 'quit' saves and stops.")
             manager.say = self._narrator(manager.teacher, person)
@@ -239,12 +264,17 @@ class ParticipantRun:
                 return None
             finally:
                 manager.transcript.close()
-            self.write(f"Session over: held-out accuracy {result.accuracy:.1%}, {result.completed} of {result.turns} "
-                       f"turns, budget spent {result.budget_spent:g} of {settings.budget:g}.")
+            if self.show_conditions:
+                self.write(f"Session over: held-out accuracy {result.accuracy:.1%}, {result.completed} of "
+                           f"{result.turns} turns, budget spent {result.budget_spent:g} of {settings.budget:g}.")
+            else:  # accuracy and budget are for the researcher (study report)
+                self.write(f"Session over: {result.completed} of {result.turns} turns.")
             return result.completed >= result.turns
         finally:
             if viewer is not None:
                 stop_viewer(viewer)
+            if self.page is not None:
+                self.page.detach()
             environment.close()
 
     def _narrator(self, teacher, person: bool):
@@ -253,5 +283,7 @@ class ParticipantRun:
                 return  # a simulated run prints one line per session
             if text.startswith("Turn") and "stays quiet" not in text and "ended the session" not in text:
                 return
+            if "stays quiet" in text and not self.show_conditions:  # its reason may name the budget
+                text = text.split(" (", 1)[0]
             teacher.say(text)
         return say

@@ -14,7 +14,7 @@ from dialog.study.records import expected_session, read_questionnaire
 from dialog.study.status import Cell, study_cells
 
 TURN_COLUMNS = ("participant", "condition", "order", "simulated", "state", "turn", "action", "cost", "answer",
-                "answer_seconds", "refused", "accuracy")
+                "answer_seconds", "refused", "accuracy", "channel", "page_seconds")
 ANSWER_COLUMNS = ("participant", "condition", "order", "simulated", "item", "kind", "value")
 COMMAND_WORDS = frozenset({"help", "?", "why", "more", "undo"})  # lines that ask something rather than answer
 
@@ -30,6 +30,15 @@ def recorded_as_simulated(study_table: dict, written_before: bool) -> bool:
     """Whether a record's study table says a scripted teacher played the participant; ``written_before`` answers
     for records written before the table had the field."""
     return bool(study_table.get("simulated", written_before))
+
+
+def answer_channel(answer: dict) -> dict:
+    """How the line taken came in a page's session (click, button, typed) and the page's seconds to it; empty for
+    a terminal session."""
+    channels, times = answer.get("channels") or [], answer.get("page_seconds") or []
+    if not channels:
+        return {"channel": None, "page_seconds": None}
+    return {"channel": channels[-1], "page_seconds": times[-1] if times else None}
 
 
 @dataclass
@@ -65,7 +74,8 @@ def collect(study) -> StudyTables:
                 turns.append({**key, "simulated": simulated, "state": cell.state.state, "turn": record["turn"],
                               "action": record["action"]["kind"], "cost": record.get("cost", 0.0),
                               "answer": answer.get("kind", "none"), "answer_seconds": answer.get("seconds", 0.0),
-                              "refused": refused_attempts(answer), "accuracy": record.get("accuracy")})
+                              "refused": refused_attempts(answer), "accuracy": record.get("accuracy"),
+                              **answer_channel(answer)})
         if files.questionnaire.exists():
             simulated = any(t["simulated"] for t in turns  # written by the same run as the session's transcript
                             if t["participant"] == cell.participant and t["condition"] == cell.condition)

@@ -26,6 +26,10 @@ SKIPPED = {
     "teachbot teach --strategy all-cd --turns 40 --budget 30 --change-every 10 --realtime 20 --viewer":
         "a person at the terminal, 20 s per turn for 40 turns",
     "teachbot expert": "a person picks the questions at the terminal",
+    "teachbot teach --web": "a person answers in the page (tests/e2e/test_web_teach.py drives it in Chromium)",
+    "teachbot study run dialog/data/studies/example.toml --participant P01 --web":
+        "a participant in the page (tests/e2e/test_web_study.py drives it in Chromium)",
+    "teachbot demo --web": "waits for a browser to open the page (tests/e2e/test_web_demo.py opens it in Chromium)",
     "teachbot study run dialog/data/studies/example.toml --participant P01": "a participant at the terminal",
     "teachbot view --task pack-lunchbox --seed 0": "serves the viewer until Ctrl-C, as the README says",
     "teachbot regress --suite ch6-dynamic": "runs long (the chapter-6 suite, minutes on every core)",

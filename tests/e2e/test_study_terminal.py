@@ -59,7 +59,7 @@ def spawn_study(cwd: Path, *args):
 def test_a_participant_runs_a_session_and_a_questionnaire_at_the_terminal(tmp_path):
     (tmp_path / "study.toml").write_text(STUDY)
     child = spawn_study(tmp_path, "run", "study.toml", "--participant", "T01", "--no-viewer")
-    child.expect_exact("=== Session 1 of 2 (ask) ===")
+    child.expect_exact("=== Session 1 of 2 ===")
     child.expect_exact("Condition ASK: label what the robot points at.")
     child.expect_exact("Press Enter to begin.")
     child.sendline("")
@@ -69,17 +69,17 @@ def test_a_participant_runs_a_session_and_a_questionnaire_at_the_terminal(tmp_pa
             answer(child, "purple elephant", "I didn't understand")
             child.expect("> ")
         answer(child, "a fruit", "is a fruit")
-    child.expect_exact("Session over: held-out accuracy")
+    child.expect_exact("Session over: 3 of 3 turns.")
     child.expect_exact("1 = disagree ... 5 = agree")
     child.expect("> ")
     answer(child, "9", "Please type a whole number from 1 to 5")
     child.expect("> ")
     answer(child, "4", "Anything else?")
     child.expect("> ")
-    answer(child, "it pointed well", "Answers saved (1-ask-questionnaire.jsonl)")
+    answer(child, "it pointed well", "Answers saved.")
     child.expect_exact("Take a short break now.")
     child.sendline("")
-    child.expect_exact("=== Session 2 of 2 (quiet) ===")
+    child.expect_exact("=== Session 2 of 2 ===")
     child.expect_exact("Press Enter to begin.")
     child.sendline("")
     assert next_question(child) == "label"
@@ -107,7 +107,7 @@ def test_a_participant_runs_a_session_and_a_questionnaire_at_the_terminal(tmp_pa
 
     child = spawn_study(tmp_path, "run", "study.toml", "--participant", "T01", "--no-viewer")  # goes on
     child.expect_exact("1 to run now.")
-    child.expect_exact("=== Session 2 of 2 (quiet) ===")
+    child.expect_exact("=== Session 2 of 2 ===")
     child.expect_exact("(This session was interrupted after 0 turns; it goes on from there.)")
     child.sendline("")
     assert next_question(child) == "label"
@@ -116,7 +116,7 @@ def test_a_participant_runs_a_session_and_a_questionnaire_at_the_terminal(tmp_pa
     child.expect("> ")
     answer(child, "skip", "Anything else?")
     child.expect("> ")
-    answer(child, "", "Answers saved (2-quiet-questionnaire.jsonl)")
+    answer(child, "", "Answers saved.")
     child.expect_exact("T01: all sessions done for now.")
     child.expect(pexpect.EOF)
     child.close()
@@ -152,3 +152,24 @@ def test_the_continue_line_repeats_the_folder_and_runs_as_printed(tmp_path):
     again.sendeof()
     again.expect(pexpect.EOF)
     assert (tmp_path / "pilot" / "T02" / "1-quiet.jsonl").exists() and not (tmp_path / "records").exists()
+
+
+@pytest.mark.parametrize("pilot", [False, True])
+def test_participants_see_no_condition_strategy_or_budget_unless_a_pilot_asks(tmp_path, pilot):
+    """Issue 23, case 3: "Session 1 of 2" and the instructions only; --show-conditions brings the rest back."""
+    import subprocess
+
+    (tmp_path / "study.toml").write_text(STUDY)
+    answers = ["", "fruit", "fruit", "fruit", "4", "fine", "", ""]
+    run = subprocess.run([TEACHBOT, "study", "run", "study.toml", "--participant", "T02", "--no-viewer",
+                          *(["--show-conditions"] if pilot else [])], cwd=tmp_path, input="\n".join(answers) + "\n",
+                         capture_output=True, text=True, timeout=180, env=dict(os.environ, NO_COLOR="1"))
+    assert run.returncode == 0, run.stderr
+    shown = run.stdout
+    assert "=== Session 1 of 2" in shown and "Condition QUIET: the robot may ask once." in shown
+    revealing = ("(quiet)", "(ask)", "active", "budget", "quiet, ask", "quiet-questionnaire")
+    if pilot:
+        assert "=== Session 1 of 2 (quiet) ===" in shown and "budget left" in shown and "quiet, ask" in shown
+    else:
+        assert [word for word in revealing if word in shown] == []
+        assert "Robot stays quiet." in shown  # the quiet turns, without the reason that names the budget

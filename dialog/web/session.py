@@ -1,0 +1,170 @@
+"""``--web`` for the commands that run a session: the options, and the page, its server and 3D view together.
+
+Wiring, in a command module::
+
+    add_web_options(parser)                          # in register()
+    with WebPage.open(args, environment) as page:    # in run(), when args.web
+        manager, records = open_session(..., teacher=page.teacher, observers=page.observers)
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+
+from dialog.web.server import LOOPBACK, WebServer, check_host, is_loopback, meshcat_socket, public_origin
+from dialog.web.teacher import WebTeacher
+from learning.errors import SettingsError
+
+
+def add_web_options(parser: argparse.ArgumentParser, what: str = "answer the robot's questions") -> None:
+    group = parser.add_argument_group("web page")
+    group.add_argument("--web", action="store_true",
+                       help=f"{what} in a browser page instead of the terminal (the URL is printed; 127.0.0.1 only)")
+    group.add_argument("--host", default=LOOPBACK, help="with --web: the address to serve on (default 127.0.0.1; "
+                                                        "another needs --allow-remote)")
+    group.add_argument("--port", type=_port, default=0, help="with --web: the port (default: any free one)")
+    group.add_argument("--allow-remote", action="store_true",
+                       help="with --web: allow --host other than loopback (prints what it exposes; docs/web.md)")
+    group.add_argument("--no-3d", dest="no_3d", action="store_true",
+                       help="with --web: no 3D view, the camera picture only (lighter for a slow machine or browser)")
+    group.add_argument("--origin", action="append", default=[], metavar="URL",
+                       help="with --web: a reverse proxy's public address the page may come from, e.g. "
+                            "https://study.example.org (repeatable)")
+
+
+def _port(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a port number from 0 to 65535, got '{text}'") from None
+    if not 0 <= value <= 65535:
+        raise argparse.ArgumentTypeError(f"expected a port number from 0 to 65535, got {value}")
+    return value
+
+
+def check_web_options(args: argparse.Namespace) -> None:
+    """The page's options make sense together (checked before anything starts)."""
+    if not getattr(args, "web", False):
+        given = [name for name, default in (("--host", LOOPBACK), ("--port", 0), ("--allow-remote", False),
+                                            ("--origin", []), ("--no-3d", False))
+                 if getattr(args, name[2:].replace("-", "_"), default) != default]
+        if given:
+            raise SettingsError(f"{', '.join(given)} only {'goes' if len(given) == 1 else 'go'} with --web")
+        return
+    check_host(args.host, args.allow_remote)
+    for origin in args.origin:
+        public_origin(origin)
+
+
+WAIT_FOR_PAGE_S = 60.0
+
+
+class Watcher:
+    """A dialog observer that shows a scripted episode in the page as it happens (``demo --web``)."""
+
+    def __init__(self, teacher):
+        self.teacher = teacher
+        self.turn = 0
+
+    def on_scene(self, scene=None) -> None:
+        self.teacher.say(f"-- turn {self.turn + 1}: the robot looks at a new scene of "
+                         f"{getattr(scene, 'n_objects', '?')} objects")
+
+    def on_question(self, action, text=None, scene=None) -> None:
+        index = getattr(action, "object_index", None)
+        self.teacher.watch(self.turn + 1, str(getattr(action, "kind", "")), text or "",
+                           None if index is None else int(index) + 1)
+
+    def on_answer(self, action, outcome=None, scene=None) -> None:
+        self.teacher.heard(getattr(outcome, "raw", "") or f"({getattr(outcome, 'kind', 'no answer')})")
+
+    def on_turn(self, record=None, scene=None) -> None:
+        self.turn += 1
+        if isinstance(record, dict) and record.get("action", {}).get("kind") == "none":
+            self.teacher.say(f"Turn {self.turn}: the robot stays quiet.")
+
+
+class WebPage:
+    """The page for one session or one participant's run: a :class:`WebTeacher`, the server, and the live 3D
+    view of the kitchen being taught (``attach``; a study attaches each session's kitchen in turn)."""
+
+    def __init__(self, args: argparse.Namespace, title: str = "Teaching the robot", out=None, three_d: bool = True):
+        self.out = out or sys.stdout
+        self.args, self.three_d = args, three_d and not getattr(args, "no_3d", False)
+        self.teacher = WebTeacher(echo=self.out)
+        self.viewer = None
+        self.server = WebServer(self.teacher, host=args.host, port=args.port, allow_remote=args.allow_remote,
+                                origins=tuple(args.origin), title=title)
+        if args.allow_remote and not is_loopback(args.host):
+            print(f"warning: --allow-remote: the page is served on {args.host}:{self.server.port} without TLS. Anyone "
+                  "who can reach it and has the URL (its token) sees the camera pictures, the 3D view and the "
+                  "conversation, and can answer the robot; put it behind a reverse proxy with TLS (docs/web.md)",
+                  file=sys.stderr, flush=True)
+        print(f"Open the page: {self.server.url}", file=self.out, flush=True)
+
+    @classmethod
+    def for_session(cls, args: argparse.Namespace, environment, **options) -> WebPage:
+        page = cls(args, **options)
+        try:
+            page.attach(environment)
+        except BaseException:
+            page.close()
+            raise
+        return page
+
+    def attach(self, environment) -> None:
+        """Show ``environment``'s kitchen: clicks on its camera picture, its 3D view (when meshcat starts)."""
+        self.detach()
+        self.teacher.locate = getattr(environment, "picture_pixels", None)
+        if self.three_d and getattr(environment, "world", None) is not None:
+            from dialog.commands._viewer import start_viewer
+
+            export = getattr(self.args, "viewer_export", None)
+            self.viewer = start_viewer(argparse.Namespace(viewer=True, viewer_export=export), environment.world)
+        self.server.meshcat_socket_url = meshcat_socket(getattr(self.viewer, "url", None))
+        self.teacher.new_view(self.viewer is not None)
+
+    def detach(self) -> None:
+        if self.viewer is not None:
+            from dialog.commands._viewer import stop_viewer
+
+            viewer, self.viewer = self.viewer, None
+            self.server.meshcat_socket_url = None
+            stop_viewer(viewer)
+
+    @property
+    def url(self) -> str:
+        return self.server.url
+
+    @property
+    def observers(self) -> tuple:
+        return (self.viewer, self) if self.viewer is not None else (self,)
+
+    def on_scene(self, scene=None) -> None:
+        """A new scene: tell the page which 3D node is which object, for clicks in the 3D view."""
+        if self.viewer is not None:
+            nodes = {node.rsplit("/", 1)[-1]: index + 1 for index, node in enumerate(self.viewer.reader.object_nodes)}
+            self.teacher.set_nodes(nodes)
+
+    def wait_for_viewer_page(self, timeout_s: float = WAIT_FOR_PAGE_S) -> bool:
+        """Wait until a browser has the page open (a demo should not end before anyone sees it); False if none
+        came within ``timeout_s`` (the episode then goes on anyway)."""
+        print(f"Waiting for a browser to open the page (up to {timeout_s:g} s; Ctrl-C stops)", file=self.out,
+              flush=True)
+        end = time.monotonic() + timeout_s
+        while not self.server.sockets:
+            if time.monotonic() > end:
+                return False
+            time.sleep(0.1)
+        return True
+
+    def watcher(self) -> Watcher:
+        return Watcher(self.teacher)
+
+    def close(self, text: str = "") -> None:
+        """The session is over: the page says so, then the server and the 3D view stop."""
+        self.teacher.end(text)
+        self.server.close()
+        self.detach()

@@ -1,0 +1,363 @@
+// The teaching page: shows the session's state and sends answers; the server checks every message.
+"use strict";
+
+const TOKEN = document.body.dataset.token;
+const WS_BASE = (location.protocol === "https:" ? "wss://" : "ws://") + location.host;
+const $ = (id) => document.getElementById(id);
+let socket = null;
+let question = null;     // the open question, as the server described it
+let waiting = false;     // whether the robot waits for an answer now
+let shownAt = 0;         // when this page first showed the open question (for page_ms)
+let ended = false;
+let viewer = null;       // the meshcat 3D view, when its script loaded
+let objectNodes = {};    // meshcat node name -> object number (for clicks in the 3D view)
+let view = 0;            // which 3D view is connected (0: none)
+
+function status(text) { $("status").textContent = text; }
+
+function connect() {
+  socket = new WebSocket(`${WS_BASE}/ws?token=${encodeURIComponent(TOKEN)}`);
+  socket.onopen = () => status("Connected");
+  socket.onmessage = (event) => handle(JSON.parse(event.data));
+  socket.onclose = () => {
+    if (ended) { status("The session is over."); return; }
+    status("Connection lost: reconnecting…");
+    setTimeout(connect, 1000);
+  };
+}
+
+function send(message) {
+  if (!question || !waiting || !socket || socket.readyState !== WebSocket.OPEN) { return; }
+  message.question = question.id;
+  message.page_ms = Math.round(performance.now() - shownAt);
+  $("refused").textContent = "";
+  setWaiting(false);
+  socket.send(JSON.stringify(message));
+}
+
+function handle(message) {
+  if (message.type === "state") {
+    $("conversation").replaceChildren();
+    message.conversation.forEach(addLine);
+    if (message.question) { showQuestion(message.question); } else { clearQuestion(); }
+    if (message.screen) { showScreen(message.screen); }
+    if (message.view !== view) { start3d(message.view); }
+    setWaiting(message.waiting);
+    if (message.ended) { showEnded(""); }
+    objectNodes = message.nodes || {};
+  } else if (message.type === "line") {
+    addLine(message);
+  } else if (message.type === "question") {
+    showQuestion(message.question);
+  } else if (message.type === "waiting") {
+    if (question && message.question === question.id) { setWaiting(true); }
+  } else if (message.type === "refused") {
+    $("refused").textContent = `Not taken: ${message.reason}`;
+    setWaiting(true);
+  } else if (message.type === "screen") {
+    showScreen(message.screen);
+  } else if (message.type === "ended") {
+    showEnded(message.text);
+  } else if (message.type === "view") {
+    start3d(message.view);
+  } else if (message.type === "nodes") {
+    objectNodes = message.nodes;
+  }
+}
+
+function addLine(entry) {
+  const item = document.createElement("li");
+  item.className = entry.who;
+  item.textContent = (entry.who === "robot" ? "Robot: " : entry.who === "teacher" ? "You: " : "") + entry.text;
+  $("conversation").appendChild(item);
+  item.scrollIntoView({block: "nearest"});
+}
+
+function button(label, key, onClick, primary) {
+  const element = document.createElement("button");
+  element.type = "button";
+  if (key) {
+    const hint = document.createElement("kbd");
+    hint.textContent = key;
+    element.append(hint, " ");
+    element.dataset.key = key;
+  }
+  element.append(label);
+  if (primary) { element.className = "primary"; }
+  element.addEventListener("click", onClick);
+  return element;
+}
+
+function showQuestion(asked) {
+  const fresh = !question || question.id !== asked.id;
+  question = asked;
+  if (fresh) { shownAt = performance.now(); }
+  $("screen").hidden = true;
+  $("ask").hidden = false;
+  $("typed").hidden = $("commands").hidden = Boolean(asked.watch);  // a demo: watched, not answered
+  let meta = `Turn ${asked.turn}` + (asked.turns ? ` of ${asked.turns}` : "")
+    + (asked.budget_left === null ? "" : ` · budget left ${asked.budget_left}`);
+  if (asked.seconds_left !== null) { meta += ` · <span id="countdown">${Math.round(asked.seconds_left)}</span> s to answer`; }
+  $("meta").innerHTML = meta;
+  if (asked.seconds_left !== null) { countdown(asked.id, asked.seconds_left); }
+  $("question-text").textContent = asked.text;
+  const answers = $("answers");
+  answers.replaceChildren();
+  if (asked.watch) {
+    status(`Turn ${asked.turn}: the scripted teacher answers`);
+  } else if (asked.expects === "label") {
+    asked.concepts.forEach((concept, i) => {
+      answers.appendChild(button(concept, i < 9 ? String(i + 1) : "", () => send({type: "concept", concept}), true));
+    });
+    answers.appendChild(button("don't know", "d", () => send({type: "command", command: "don't know"})));
+  } else if (asked.expects === "demo") {
+    const hint = document.createElement("p");
+    hint.textContent = "Click the object in the camera picture or the 3D view, or:";
+    answers.appendChild(hint);
+    answers.appendChild(button("none here", "n", () => send({type: "command", command: "none"}), true));
+    answers.appendChild(button("don't know", "d", () => send({type: "command", command: "don't know"})));
+    const numbers = document.createElement("div");
+    numbers.id = "object-numbers";
+    numbers.setAttribute("aria-label", "Or choose the object by its number");
+    for (let n = 1; n <= asked.objects; n++) {
+      const pick = button(String(n), "", () => send({type: "object", object: n}));
+      pick.setAttribute("aria-label", `object ${n}`);
+      numbers.appendChild(pick);
+    }
+    answers.appendChild(numbers);
+  } else if (asked.expects === "feature") {
+    answers.appendChild(featureTree(asked.features));
+    answers.appendChild(button("use these", "", () => sendFeatures("use"), true));
+    answers.appendChild(button("ignore these", "", () => sendFeatures("ignore")));
+  }
+  if (asked.picture) {
+    $("picture").src = `/picture/${asked.id}?token=${encodeURIComponent(TOKEN)}`;
+    $("picture").hidden = false;
+    $("picture-caption").textContent = asked.expects === "demo"
+      ? "Camera picture: click the object you mean." : "Camera picture (the robot's view, numbered).";
+  }
+}
+
+function clearQuestion() {
+  question = null;
+  $("question-text").textContent = "";
+  $("answers").replaceChildren();
+  $("meta").textContent = "";
+}
+
+function featureTree(rows) {
+  const box = document.createElement("div");
+  box.id = "features";
+  rows.forEach((row) => {
+    const label = document.createElement("label");
+    label.style.paddingLeft = `${row.depth * 1.5}em`;
+    const check = document.createElement("input");
+    check.type = "checkbox";
+    check.value = row.number;
+    check.dataset.number = row.number;
+    check.addEventListener("change", () => {  // a group checks or clears everything under it
+      box.querySelectorAll("input").forEach((other) => {
+        if (other.value.startsWith(row.number + ".")) { other.checked = check.checked; }
+      });
+    });
+    label.append(check, ` ${row.number} ${row.name}`);
+    if (row.description) {
+      const description = document.createElement("span");
+      description.className = "description";
+      description.textContent = ` (${row.description})`;
+      label.append(description);
+    }
+    if (row.group) { label.style.fontWeight = "600"; }
+    box.appendChild(label);
+  });
+  return box;
+}
+
+function sendFeatures(mode) {
+  // the fewest numbers: a checked group stands for everything under it
+  const checked = [...document.querySelectorAll("#features input:checked")].map((c) => c.value);
+  const numbers = checked.filter((n) => !checked.some((m) => m !== n && n.startsWith(m + ".")));
+  if (numbers.length === 0) { $("refused").textContent = "Tick at least one group or feature first."; return; }
+  send({type: "features", mode, numbers});
+}
+
+function setWaiting(on) {
+  waiting = Boolean(on) && !ended;
+  document.querySelectorAll("#ask button, #ask input").forEach((element) => { element.disabled = !waiting; });
+  if (waiting && question) { status(`Turn ${question.turn}: your answer, please`); }
+  else if (!ended) { status("The robot is busy…"); }
+}
+
+function showEnded(text) {
+  ended = true;
+  setWaiting(false);
+  question = null;
+  $("question-text").textContent = text || "The session is over. Thank you!";
+  $("answers").replaceChildren();
+  status("The session is over.");
+}
+
+function countdown(id, seconds) {
+  const end = performance.now() + seconds * 1000;
+  const tick = () => {
+    const element = $("countdown");
+    if (!element || !question || question.id !== id) { return; }
+    element.textContent = Math.max(0, Math.round((end - performance.now()) / 1000));
+    if (performance.now() < end) { setTimeout(tick, 250); }
+  };
+  tick();
+}
+
+// -- study screens: instructions and the questionnaire ------------------------------------------------
+function showScreen(screen) {
+  const box = $("screen");
+  box.replaceChildren();
+  box.hidden = false;
+  $("ask").hidden = true;
+  const heading = document.createElement("h2");
+  heading.textContent = screen.title;
+  box.appendChild(heading);
+  (screen.text || "").split("\n").filter((t) => t.trim()).forEach((paragraph) => {
+    const p = document.createElement("p");
+    p.textContent = paragraph;
+    box.appendChild(p);
+  });
+  const form = document.createElement("form");
+  (screen.items || []).forEach((item, i) => form.appendChild(questionnaireItem(item, i)));
+  const submit = button(screen.button || "Continue", "", () => {
+    const answers = (screen.items || []).map((item, i) => {
+      if (item.kind === "likert") {
+        const chosen = form.querySelector(`input[name="item-${i}"]:checked`);
+        return chosen ? chosen.value : "";
+      }
+      return form.querySelector(`[name="item-${i}"]`).value;
+    });
+    socket.send(JSON.stringify({type: "screen", screen: screen.id, answers}));
+    submit.disabled = true;
+  }, true);
+  form.appendChild(submit);
+  box.appendChild(form);
+  submit.focus();
+}
+
+function questionnaireItem(item, i) {
+  const set = document.createElement("fieldset");
+  const legend = document.createElement("legend");
+  legend.textContent = item.text;
+  set.appendChild(legend);
+  if (item.kind === "likert") {
+    for (let value = item.low; value <= item.high; value++) {
+      const label = document.createElement("label");
+      const radio = document.createElement("input");
+      radio.type = "radio";
+      radio.name = `item-${i}`;
+      radio.value = String(value);
+      label.append(radio, ` ${value}${value === item.low ? " " + item.low_label : value === item.high ? " " + item.high_label : ""} `);
+      set.appendChild(label);
+    }
+  } else {
+    const text = document.createElement("textarea");
+    text.name = `item-${i}`;
+    text.rows = 2;
+    text.maxLength = 1000;
+    text.setAttribute("aria-label", item.text);
+    set.appendChild(text);
+  }
+  return set;
+}
+
+// -- answering by pointing: the camera picture and the 3D view ----------------------------------------
+$("picture").addEventListener("click", (event) => {
+  if (!question || question.expects !== "demo") { return; }
+  const box = event.target.getBoundingClientRect();
+  send({type: "click", x: (event.clientX - box.left) / box.width, y: (event.clientY - box.top) / box.height});
+});
+
+function start3d(which) {
+  // (re)connect the 3D view: a study's next session brings another kitchen's mirror
+  view = which;
+  $("view3d").replaceChildren();
+  viewer = null;
+  if (!which || typeof MeshCat === "undefined") { return; }
+  viewer = new MeshCat.Viewer($("view3d"));
+  if (viewer.gui) { viewer.gui.close(); }
+  fit3d();
+  throttle3d();
+  viewer.connect(`${WS_BASE}/meshcat-ws?token=${encodeURIComponent(TOKEN)}&view=${which}`);
+}
+
+// A click in the 3D view: meshcat's orbit controls take the pointer from the canvas, so the press and the
+// release are watched on the document; one in the same place on the canvas picks the object under it.
+let pressed = null;
+function onCanvas(event) {
+  if (!viewer) { return false; }
+  const box = viewer.renderer.domElement.getBoundingClientRect();
+  return event.clientX >= box.left && event.clientX <= box.right && event.clientY >= box.top && event.clientY <= box.bottom;
+}
+document.addEventListener("pointerdown", (event) => { pressed = onCanvas(event) ? [event.clientX, event.clientY] : null; }, true);
+document.addEventListener("pointerup", (event) => {
+  const still = pressed && onCanvas(event) && Math.hypot(event.clientX - pressed[0], event.clientY - pressed[1]) < 5;
+  pressed = null;
+  if (!still || !question || question.expects !== "demo") { return; }
+  const number = objectAt(event);
+  if (number !== null) { send({type: "pick", object: number}); }
+}, true);
+
+const BUSY_3D_FPS = 3;  // while the robot works: a software-rendering browser would take the cores it needs
+
+function throttle3d() {
+  // meshcat renders on the next animation frame after every change; while the robot is busy (pointing,
+  // deciding), at most BUSY_3D_FPS times a second; while it waits for the answer, freely (orbiting the view)
+  const render = viewer.render.bind(viewer);
+  let last = 0;
+  viewer.render = () => {
+    const now = performance.now();
+    if (!waiting && now - last < 1000 / BUSY_3D_FPS) { viewer.needs_render = true; return; }
+    last = now;
+    render();
+  };
+}
+
+function fit3d() {
+  // meshcat sizes its canvas to the window's height whenever it resizes; here it always takes the page's box
+  if (!viewer) { return; }
+  const resize = viewer.set_3d_pane_size.bind(viewer);
+  viewer.set_3d_pane_size = () => resize($("view3d").clientWidth, $("view3d").clientHeight);
+  viewer.set_3d_pane_size();
+}
+
+function objectAt(event) {
+  // the object under the cursor: the first hit whose node (or an ancestor's) is a scene object's
+  const box = viewer.renderer.domElement.getBoundingClientRect();
+  const pointer = new MeshCat.THREE.Vector2(((event.clientX - box.left) / box.width) * 2 - 1,
+                                             -((event.clientY - box.top) / box.height) * 2 + 1);
+  const ray = new MeshCat.THREE.Raycaster();
+  ray.setFromCamera(pointer, viewer.camera);
+  for (const hit of ray.intersectObjects(viewer.scene.children, true)) {
+    for (let node = hit.object; node; node = node.parent) {
+      if (node.name in objectNodes) { return objectNodes[node.name]; }
+    }
+  }
+  return null;
+}
+
+document.addEventListener("keydown", (event) => {
+  if (event.target.tagName === "INPUT" || event.target.tagName === "TEXTAREA" || event.ctrlKey || event.altKey || event.metaKey) { return; }
+  const target = document.querySelector(`#ask button[data-key="${CSS.escape(event.key)}"]`);
+  if (target && !target.disabled) { event.preventDefault(); target.click(); }
+});
+
+$("commands").addEventListener("click", (event) => {
+  const command = event.target.closest("button")?.dataset.command;
+  if (command) { send({type: "command", command}); }
+});
+
+$("typed").addEventListener("submit", (event) => {
+  event.preventDefault();
+  const text = $("line").value;
+  if (!text.trim()) { return; }
+  $("line").value = "";
+  send({type: "typed", text});
+});
+
+connect();

@@ -1,0 +1,175 @@
+"""Benchmark: answering in the browser page against answering at the terminal, the same session in the same run.
+
+    python scripts/bench_web.py                   # 20 turns of dt-task, seed 0
+    python scripts/bench_web.py --turns 30 --json # JSON last line
+    python scripts/bench_web.py --no-3d           # the page without its 3D view
+
+A real ``teachbot teach --web`` session is answered in headless Chromium by
+clicks (a concept button, an object's number button, the feature checkboxes);
+for every answer the time from the click to the next question being shown and
+waiting in the page is measured (and, of it, the time until the question's
+message reached the browser), and the page's load time (from opening the URL
+to the first question ready to answer, 3D view included). Then the same answers
+are typed into ``teachbot teach`` at a pseudo-terminal, and the time from
+Enter to the next prompt is measured the same way. Both include the robot's own
+work between the questions (the strategy's decision, the arm's pointing);
+the difference is what the page costs. Goal: page p95 under 300 ms beside a DT
+decision, i.e. the page adds less than 300 ms to the terminal's p95.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import re
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+
+from bullet_world.viewer.snapshot import CHROMIUM_FLAGS, find_chromium
+from dialog.transcript import read_session
+
+TEACHBOT = str(Path(sys.executable).with_name("teachbot"))
+GOAL_MS = 300.0
+QUESTION = re.compile(r"(Which features tell|Can you show me|What is the)")
+
+
+def web_session(args, folder: Path) -> dict:
+    """Answer a --web session by clicks; the click-to-question times and the page's load time."""
+    from playwright.sync_api import sync_playwright
+
+    command = [TEACHBOT, "teach", "--web", "--seed", str(args.seed), "--turns", str(args.turns), "--strategy",
+               args.strategy, "--transcript", "runs/web.jsonl", *(["--no-3d"] if args.no_3d else [])]
+    process = subprocess.Popen(command, cwd=folder, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
+    url = None
+    for line in process.stdout:
+        found = re.search(r"Open the page: (\S+)", line)
+        if found:
+            url = found.group(1)
+            break
+    threading.Thread(target=lambda: [None for _ in process.stdout], daemon=True).start()
+    if url is None:
+        raise SystemExit("teachbot teach --web printed no URL")
+    times, arrivals, received = [], [], {}
+
+    def watch(socket) -> None:  # when each "waiting" message reaches the browser (its network layer)
+        def frame(payload) -> None:
+            message = json.loads(payload) if isinstance(payload, str) else {}
+            if message.get("type") == "waiting":
+                received[message["question"]] = time.perf_counter()
+        if "/ws?" in socket.url:
+            socket.on("framereceived", frame)
+
+    try:
+        with sync_playwright() as driver:
+            browser = driver.chromium.launch(executable_path=find_chromium(), args=list(CHROMIUM_FLAGS))
+            page = browser.new_page(viewport={"width": 1400, "height": 1000})
+            page.on("websocket", watch)
+            started = time.perf_counter()
+            page.goto(url)
+            page.wait_for_function("() => question && waiting", timeout=120_000)
+            load_ms = (time.perf_counter() - started) * 1000
+            while True:
+                question = page.evaluate("() => question")
+                clicked = time.perf_counter()
+                if question["expects"] == "label":
+                    page.locator("#answers button").first.click()
+                elif question["expects"] == "demo":
+                    page.get_by_role("button", name="object 1", exact=True).click()
+                else:
+                    page.locator("#features input[data-number='1.1']").check()
+                    clicked = time.perf_counter()
+                    page.get_by_role("button", name="use these").click()
+                page.wait_for_function("(id) => ended || (question && waiting && question.id !== id)",
+                                       arg=question["id"], timeout=120_000, polling=5)
+                shown = time.perf_counter()
+                if page.evaluate("() => ended"):
+                    break
+                times.append((shown - clicked) * 1000)
+                arrivals.append((received.get(page.evaluate("() => question.id"), shown) - clicked) * 1000)
+            browser.close()
+        process.wait(60)
+    finally:
+        if process.poll() is None:
+            process.kill()
+    return {"click_to_question_ms": times, "click_to_arrival_ms": arrivals, "page_load_ms": load_ms}
+
+
+def terminal_session(args, folder: Path, lines: list[str]) -> list[float]:
+    """Type the same lines at a pseudo-terminal; the Enter-to-next-prompt times."""
+    import pexpect
+
+    env = dict(os.environ, TERM="dumb", NO_COLOR="1", COLUMNS="200")
+    child = pexpect.spawn(TEACHBOT, ["teach", "--seed", str(args.seed), "--turns", str(args.turns), "--strategy",
+                                     args.strategy, "--transcript", "runs/terminal.jsonl"], cwd=str(folder), env=env,
+                          encoding="utf-8", timeout=120, dimensions=(50, 200))
+    child.expect(QUESTION)
+    child.expect("> ")
+    times = []
+    for line in lines:
+        sent = time.perf_counter()
+        child.sendline(line)
+        if child.expect([QUESTION, pexpect.EOF]) == 1:
+            break
+        child.expect("> ")
+        times.append((time.perf_counter() - sent) * 1000)
+    child.expect(pexpect.EOF)
+    return times
+
+
+def summary(times: list[float]) -> dict:
+    values = np.asarray(times, dtype=float)
+    return {"n": int(values.size), "p50": round(float(np.percentile(values, 50)), 1),
+            "p95": round(float(np.percentile(values, 95)), 1), "max": round(float(values.max()), 1)}
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--turns", type=int, default=20)
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--strategy", default="dt-task")
+    parser.add_argument("--no-3d", action="store_true", help="the page without its 3D view (camera picture only)")
+    parser.add_argument("--json", action="store_true", help="end with one JSON line")
+    args = parser.parse_args(argv)
+    if find_chromium() is None:
+        raise SystemExit("no Chromium found: apt-get install -y chromium")
+    with tempfile.TemporaryDirectory(prefix="teachbot-bench-web-") as tmp:
+        folder = Path(tmp)
+        web = web_session(args, folder)
+        records = read_session(folder / "runs/web.jsonl")[1]
+        lines = [line for record in records for line in record["answer"]["lines"]]
+        terminal = terminal_session(args, folder, lines)
+        _, typed = read_session(folder / "runs/terminal.jsonl")
+    same = [r["action"] for r in records] == [r["action"] for r in typed]
+    page, at_terminal = summary(web["click_to_question_ms"]), summary(terminal)
+    arrival = summary(web["click_to_arrival_ms"])
+    overhead = round(page["p95"] - at_terminal["p95"], 1)
+    result = {"turns": args.turns, "seed": args.seed, "strategy": args.strategy, "3d_view": not args.no_3d,
+              "same_questions": same,
+              "page_click_to_question_ms": page, "page_click_to_arrival_ms": arrival,
+              "terminal_enter_to_question_ms": at_terminal,
+              "page_load_ms": round(web["page_load_ms"], 1), "page_p95_overhead_ms": overhead,
+              "goal_ms": GOAL_MS, "goal_met": page["p95"] < at_terminal["p95"] + GOAL_MS}
+    print(f"{args.turns} turns of {args.strategy}, seed {args.seed}, 3D view {'off' if args.no_3d else 'on'} "
+          f"(the same questions at both: {same})")
+    print(f"page:     click to next question  p50 {page['p50']:.0f} ms  p95 {page['p95']:.0f} ms  "
+          f"max {page['max']:.0f} ms  (n={page['n']})")
+    print(f"          of which until the question reached the browser  p50 {arrival['p50']:.0f} ms  "
+          f"p95 {arrival['p95']:.0f} ms (the rest: the page showing it)")
+    print(f"terminal: Enter to next question  p50 {at_terminal['p50']:.0f} ms  p95 {at_terminal['p95']:.0f} ms  "
+          f"max {at_terminal['max']:.0f} ms  (n={at_terminal['n']})")
+    print(f"the page adds {overhead:.0f} ms at p95 (goal: under {GOAL_MS:.0f} ms); page load "
+          f"{web['page_load_ms']:.0f} ms (to the first question ready{', 3D view included' if not args.no_3d else ''})")
+    if args.json:
+        print(json.dumps(result))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,64 @@
+"""``demo --pace`` and ``demo --web``: a scripted episode a person can follow, with the very same transcript."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import time
+
+import pytest
+
+from bullet_world.viewer.snapshot import find_chromium
+from tests.e2e.web_helpers import TEACHBOT, WebCommand, chromium
+
+pytestmark = pytest.mark.e2e
+
+
+def demo(cwd, *args) -> tuple[float, subprocess.CompletedProcess]:
+    started = time.monotonic()
+    done = subprocess.run([TEACHBOT, "demo", "--turns", "4", *map(str, args)], cwd=cwd, capture_output=True,
+                          text=True, timeout=180)
+    return time.monotonic() - started, done
+
+
+def test_pace_makes_each_turn_last_its_seconds_and_changes_nothing_recorded(tmp_path):
+    """Issue 23, case 8: the episode is played at a speed a person can follow; the transcript stays the same."""
+    fast, plain = demo(tmp_path, "--transcript", "fast.jsonl")
+    slow, paced = demo(tmp_path, "--transcript", "slow.jsonl", "--pace", "1.5")
+    assert plain.returncode == paced.returncode == 0, plain.stderr + paced.stderr
+    assert slow >= 4 * 1.5 > fast - 1.0  # each of the 4 turns lasts at least 1.5 s of wall time
+    assert (tmp_path / "fast.jsonl").read_bytes() == (tmp_path / "slow.jsonl").read_bytes()
+
+
+@pytest.mark.browser
+@pytest.mark.skipif(find_chromium() is None, reason="no Chromium at /usr/bin/chromium: apt-get install -y chromium")
+def test_demo_web_shows_the_scripted_episode_turn_by_turn(tmp_path):
+    pytest.importorskip("playwright.sync_api", reason="needs playwright")
+    command = WebCommand("demo", "--web", "--turns", "4", "--transcript", "web.jsonl", cwd=tmp_path)
+    shown: list[tuple[float, int]] = []  # when each question reached the page, and its turn
+
+    def frames(socket) -> None:
+        def received(payload) -> None:
+            message = json.loads(payload) if isinstance(payload, str) else {}
+            if message.get("type") == "question":
+                shown.append((time.monotonic(), message["question"]["turn"]))
+        if socket.url.split("?")[0].endswith("/ws"):
+            socket.on("framereceived", received)
+
+    try:
+        with chromium() as browser:
+            page = browser.new_page(viewport={"width": 1400, "height": 1000})
+            page.on("websocket", frames)
+            page.goto(command.url)
+            page.wait_for_function("() => ended", timeout=120_000)
+            assert page.locator("#typed").is_hidden() and page.locator("#commands").is_hidden()  # watched only
+            conversation = page.inner_text("#conversation")
+        assert command.finish() == 0
+    finally:
+        command.stop()
+    assert [turn for _, turn in shown] == [1, 2, 3, 4]
+    gaps = [later - earlier for (earlier, _), (later, _) in zip(shown, shown[1:])]
+    assert min(gaps) > 1.0  # the default pace with a page: about 1.5 s a turn
+    assert conversation.count("You: ") == 4 and conversation.count("What is") >= 1
+    _, plain = demo(tmp_path, "--transcript", "plain.jsonl")
+    assert (tmp_path / "web.jsonl").read_bytes() == (tmp_path / "plain.jsonl").read_bytes()

@@ -1,0 +1,195 @@
+"""``teachbot teach --web`` in real headless Chromium: a whole session by buttons, clicks and checkboxes.
+
+The session: labels by button, ``why`` and ``undo`` as buttons, the feature
+question by checkboxes, "show me" by clicking the object in the camera picture
+where the camera projects it, a reload and a second tab mid-session, forged and
+wrong-token messages, a quit and a resume. The transcript must equal the same
+answers typed at the terminal, field for field, but for the clock fields and
+the page's channel fields.
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import urllib.error
+import urllib.request
+
+import pytest
+
+from bullet_world.viewer.snapshot import find_chromium
+from dialog.environment import SimulatedKitchen
+from dialog.manager import episode_generators
+from dialog.transcript import read_session
+from tests.e2e.web_helpers import TEACHBOT, WebCommand, chromium, comparable, open_page, send_raw, wait_for_question
+
+pytestmark = [
+    pytest.mark.e2e, pytest.mark.browser,
+    pytest.mark.skipif(find_chromium() is None,
+                       reason="no Chromium at /usr/bin/chromium: install it with apt-get install -y chromium"),
+]
+pytest.importorskip("playwright.sync_api", reason="needs playwright (pip install playwright; the browser is chromium)")
+
+SEED, TURNS, CHANGE_EVERY = 0, 8, 5
+OPTIONS = ("--seed", SEED, "--turns", TURNS, "--change-every", CHANGE_EVERY, "--strategy", "dt-task")
+
+
+class Truth:
+    """The session's scenes rebuilt from the same seed: each object's concept and where the camera sees it."""
+
+    def __init__(self, scenes: int):
+        self.env = SimulatedKitchen(seed=SEED, pictures=True)
+        rng = episode_generators(SEED)["scenes"]
+        self.scenes = [self.env.next_scene(rng) for _ in range(scenes)]
+        self.pixels = [self.env.picture_pixels(scene) for scene in self.scenes]
+
+    def scene(self, turn: int):
+        return (turn - 1) // CHANGE_EVERY
+
+    def concept(self, turn: int, number: int) -> str:
+        return self.scenes[self.scene(turn)].truth.concepts[number - 1]
+
+    def example(self, turn: int, concept: str) -> tuple[int, tuple[float, float]] | None:
+        """An object of ``concept`` in the turn's scene: its number and its place as shares of the picture."""
+        index = self.scene(turn)
+        concepts = self.scenes[index].truth.concepts
+        pixels, width, height = self.pixels[index]
+        for i, name in enumerate(concepts):
+            if name == concept:
+                return i + 1, (pixels[i][0] / width, pixels[i][1] / height)
+        return None
+
+    def close(self):
+        self.env.close()
+
+
+def click_picture(page, share: tuple[float, float]) -> None:
+    box = page.locator("#picture").bounding_box()
+    page.locator("#picture").click(position={"x": share[0] * box["width"], "y": share[1] * box["height"]})
+
+
+def answer(page, question: dict, truth: Truth, keyboard: bool = False) -> str:
+    """Answer ``question`` as a person in the page would, by button (or its key), click or checkboxes; returns
+    how."""
+    if question["expects"] == "label":
+        concept = truth.concept(question["turn"], question["object"])
+        if keyboard:  # the concept buttons have keys 1, 2, ...
+            page.keyboard.press(str(question["concepts"].index(concept) + 1))
+        else:
+            page.get_by_role("button", name=concept, exact=False).first.click()
+        return "button"
+    if question["expects"] == "demo":
+        concept = question["text"].split("show me ")[1].split("?")[0].split(" ", 1)[1]
+        example = truth.example(question["turn"], concept)
+        if example is None:
+            page.get_by_role("button", name="none here").click()
+            return "button"
+        page.wait_for_function("() => document.getElementById('picture').complete")
+        click_picture(page, example[1])
+        return "click"
+    for number in ("1.1", "1.2", "1.5"):
+        page.locator(f"#features input[data-number='{number}']").check()
+    page.get_by_role("button", name="use these").click()
+    return "button"
+
+
+def refused_after(page, message) -> str:
+    page.evaluate("() => { document.getElementById('refused').textContent = ''; }")
+    send_raw(page, message)
+    page.wait_for_function("() => document.getElementById('refused').textContent !== ''")
+    return page.inner_text("#refused")
+
+
+def http_status(url: str, headers: dict | None = None) -> int:
+    try:
+        with urllib.request.urlopen(urllib.request.Request(url, headers=headers or {}), timeout=10) as response:
+            return response.status
+    except urllib.error.HTTPError as error:
+        return error.code
+
+
+def test_a_whole_session_in_the_browser_equals_the_same_answers_typed(tmp_path):
+    web, terminal = tmp_path / "web", tmp_path / "terminal"
+    web.mkdir()
+    terminal.mkdir()
+    truth = Truth(scenes=2)
+    channels = []
+    try:
+        with chromium() as browser:
+            first = WebCommand("teach", "--web", *OPTIONS, "--transcript", "runs/t.jsonl", cwd=web)
+            try:
+                base, token = first.url.split("?token=")
+                assert http_status(first.url) == 200
+                assert http_status(base + "?token=wrong") == 403
+                assert http_status(base) == 403
+                assert http_status(f"{base}static/app.js") == 403
+                assert http_status(first.url, {"Host": "evil.example:80"}) == 403
+
+                page = open_page(browser, first.url)
+                question = wait_for_question(page)
+                assert question["turn"] == 1
+                # a forged message, a stale one, a malformed one: refused, the question stays open
+                assert "concept \"DROP TABLE\"" in refused_after(page, {"type": "concept", "concept": "DROP TABLE",
+                                                                      "question": question["id"]})
+                assert "open question" in refused_after(page, {"type": "concept", "concept": "fruit",
+                                                               "question": question["id"] + 5})
+                assert "not JSON" in refused_after(page, "{not json")
+                assert "object pick for a label question" in refused_after(page, {"type": "pick", "object": 3,
+                                                              "question": question["id"]})
+                # a websocket with a wrong token or from a foreign page is refused
+                assert page.evaluate("""(url) => new Promise(done => { const s = new WebSocket(url);
+                    s.onopen = () => done('open'); s.onerror = () => done('refused'); })""",
+                                     base.replace("http", "ws") + "ws?token=wrong") == "refused"
+                done_turns = 0
+                while done_turns < 5:
+                    if question["turn"] == 2:
+                        page.get_by_role("button", name="Why?").click()  # a reply; the question stays open
+                        page.wait_for_function("() => waiting")
+                    if question["turn"] == 3:
+                        page.reload()  # a reload rejoins the session: the same question, still waiting
+                        again = wait_for_question(page)
+                        assert again["id"] == question["id"] and again["text"] == question["text"]
+                        second = open_page(browser, first.url)  # so does a second tab
+                        assert wait_for_question(second)["text"] == question["text"]
+                        second.close()
+                        page.get_by_role("button", name="Undo").click()  # takes back turn 2's answer
+                        page.wait_for_function("() => waiting && document.getElementById('conversation')"
+                                               ".textContent.includes('Taken back')")
+                    channels.append(answer(page, question, truth, keyboard=question["turn"] == 1))
+                    done_turns += 1
+                    question = wait_for_question(page, after=question["id"])
+                page.get_by_role("button", name="Quit").click()
+                assert first.finish() == 0
+                assert any("Session saved after 5 of 8 turns" in line for line in first.out)
+            finally:
+                first.stop()
+
+            second_run = WebCommand("teach", "--web", "--resume", "runs/t.jsonl", cwd=web)
+            try:
+                page = open_page(browser, second_run.url)
+                question = wait_for_question(page)
+                assert question["turn"] == 6
+                while not question.get("ended"):
+                    channels.append(answer(page, question, truth))
+                    question = wait_for_question(page, after=question["id"])
+                assert second_run.finish() == 0
+            finally:
+                second_run.stop()
+    finally:
+        truth.close()
+
+    header, records = read_session(web / "runs/t.jsonl")
+    assert [r["turn"] for r in records] == list(range(1, TURNS + 1))
+    assert records[2]["undid"] == [2]
+    assert "click" in channels and "button" in channels
+    for record in records:
+        assert len(record["answer"]["channels"]) == len(record["answer"]["lines"])
+    assert any("click" in r["answer"]["channels"] for r in records)
+
+    lines = [line for r in records for line in r["answer"]["lines"]]
+    typed = subprocess.run([TEACHBOT, "teach", *map(str, OPTIONS), "--transcript", "runs/t.jsonl"], cwd=terminal,
+                           input="\n".join(lines) + "\n", capture_output=True, text=True, timeout=120)
+    assert typed.returncode == 0, typed.stderr
+    _, at_terminal = read_session(terminal / "runs/t.jsonl")
+    assert "channels" not in json.dumps(at_terminal)
+    assert [comparable(r) for r in records] == [comparable(r) for r in at_terminal]
