@@ -145,6 +145,17 @@ def _whole_number(example: str):
     return parse
 
 
+def number_within(kind, low: float, high: float, what: str):
+    """An argparse type: a ``kind`` number (int or float, ASCII digits) from ``low`` to ``high``; ``what`` says
+    what is expected, e.g. "a number between 0 and 1"."""
+    def parse(text: str):
+        value = _number(text, kind, what)
+        if not low <= value <= high:
+            raise argparse.ArgumentTypeError(f"expected {what}, got {value:g}")
+        return value
+    return parse
+
+
 seed = _whole_number("give a seed of 0 or more, e.g. --seed 0")
 seeds = _whole_number("give one or more seeds, e.g. --seeds 0 1 2")
 data_seed = _whole_number("give the seed the data sets are rendered from, 0 or more, e.g. --data-seed 1")

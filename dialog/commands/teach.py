@@ -7,7 +7,14 @@ import json
 import sys
 from pathlib import Path
 
-from dialog.commands._arguments import add_episode_options, add_time_options, budget, positive_seconds, resolve_time
+from dialog.commands._arguments import (
+    add_episode_options,
+    add_time_options,
+    budget,
+    number_within,
+    positive_seconds,
+    resolve_time,
+)
 from dialog.commands._resume import check_resume_options, continue_command
 from dialog.commands._summary import questions_in_words, scene_size, session_time
 from dialog.commands._viewer import add_viewer_option, hold_viewer, start_viewer, stop_viewer
@@ -26,14 +33,7 @@ PREFERRED_STRATEGIES = ("dt-task", "dt", "all-cd", "active")
 DEFAULT_STRATEGY = next(name for name in (*PREFERRED_STRATEGIES, STRATEGY_NAMES[0]) if name in STRATEGY_NAMES)
 
 
-def rate(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a number between 0 and 1, got '{text}'") from None
-    if not 0.0 <= value <= 1.0:
-        raise argparse.ArgumentTypeError(f"expected a number between 0 and 1, got {value}")
-    return value
+rate = number_within(float, 0.0, 1.0, "a number between 0 and 1")
 
 
 def register(commands) -> None:

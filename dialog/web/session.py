@@ -13,6 +13,7 @@ import argparse
 import sys
 import time
 
+from dialog.commands._arguments import number_within
 from dialog.web.server import LOOPBACK, WebServer, check_host, is_loopback, meshcat_socket, public_origin
 from dialog.web.teacher import WebTeacher
 from learning.errors import SettingsError
@@ -34,14 +35,7 @@ def add_web_options(parser: argparse.ArgumentParser, what: str = "answer the rob
                             "https://study.example.org (repeatable)")
 
 
-def _port(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a port number from 0 to 65535, got '{text}'") from None
-    if not 0 <= value <= 65535:
-        raise argparse.ArgumentTypeError(f"expected a port number from 0 to 65535, got {value}")
-    return value
+_port = number_within(int, 0, 65535, "a port number from 0 to 65535")
 
 
 def check_web_options(args: argparse.Namespace) -> None:
