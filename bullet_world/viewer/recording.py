@@ -10,7 +10,10 @@ questions and answers can be read when the episode is played back.
 
 The export builds the whole episode in a fresh loopback meshcat server:
 every version's geometry once, its pose and visibility as animation tracks,
-and asks the server for its static HTML, which opens with no server.
+and asks the server for its static HTML, which opens with no server. The page
+opens showing the episode's last frame (the last question, its highlight, the
+arm at rest), so a plain screenshot of it shows how the episode ended; meshcat's
+Animations > default > play plays it from the start.
 """
 
 from __future__ import annotations
@@ -91,8 +94,11 @@ class Recording:
 
 
 def export_html(recording: Recording, path: str | Path, camera: tuple, title: str = "teachbot episode",
-                autoplay: bool = True) -> dict:
+                autoplay: bool = False) -> dict:
     """Write the recording as a self-contained HTML page with meshcat's animation controls.
+
+    Every node's static state is its last one, so the page opens at the episode's end;
+    ``autoplay`` starts the animation from the beginning as soon as the page loads instead.
 
     Must run on the viewer's meshcat thread (it talks to its own, temporary server).
     Returns the file's path, size, duration and counts.
@@ -129,14 +135,14 @@ def export_html(recording: Recording, path: str | Path, camera: tuple, title: st
 
 
 def _add_node(root, animation: PackedAnimation, name: str, looks: tuple[Look, ...], versions: list[Version]) -> None:
-    """Geometry once, the first pose, and tracks for the pose and the visibility over all ``versions``."""
+    """Geometry once, the last pose and visibility (what the page shows before it plays), and tracks
+    for the pose and the visibility over all ``versions``."""
     node = root[name]
     index = 0
     for look in looks:
         for json in object_jsons(look):
             node[f"p{index}"].set_object(RawObject(json))
             index += 1
-    node.set_transform(versions[0].keys[0][1])
     visible = {0: False}
     keys: list[tuple[int, np.ndarray]] = []
     for version in versions:
@@ -146,9 +152,10 @@ def _add_node(root, animation: PackedAnimation, name: str, looks: tuple[Look, ..
             visible[version.end] = False
             if version.end > keys[-1][0]:
                 keys.append((version.end, keys[-1][1]))  # hold until hidden: no drift towards the next stretch
-    if not visible[0]:
-        node.set_property("visible", False)
     times = sorted(visible)
+    node.set_transform(keys[-1][1])
+    if not visible[times[-1]]:
+        node.set_property("visible", False)
     tracks = [{"name": ".visible", "type": "boolean", "times": [float(t) for t in times],
                "values": [bool(visible[t]) for t in times]}]
     if any(not same_pose(keys[0][1], matrix, MOVE_TOLERANCE) for _, matrix in keys[1:]):

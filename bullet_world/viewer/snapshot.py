@@ -73,7 +73,8 @@ def screenshot(url: str, path: str | Path, *, min_drawn: int = 1, width: int = 1
             if hide_controls:
                 page.add_style_tag(content=HIDE_CONTROLS_CSS)
             if animation_time is not None:
-                page.evaluate("t => { viewer.animator.pause(); viewer.animator.seek(t); }", animation_time)
+                page.evaluate("t => { viewer.animator.play(); viewer.animator.pause(); viewer.animator.seek(t); }",
+                              animation_time)  # play() first: a page that does not autoplay has no active tracks
             page.wait_for_timeout(300)
             Path(path).parent.mkdir(parents=True, exist_ok=True)
             page.screenshot(path=str(path))

@@ -90,6 +90,7 @@ def test_exported_page_plays_the_episode_without_a_server(tmp_path):
     try:
         viewer.on_scene(None)
         viewer.on_question({"kind": "label", "object": 1}, "What is this (object 1)?")
+        viewer.update(dwell_s=20.0)  # long enough that a page playing from the start is still before the move
         moved = start + np.array([0.45, -0.25, 0.0])
         p.resetBasePositionAndOrientation(box, moved.tolist(), [0, 0, 0, 1], physicsClientId=world.client)
         viewer.update(dwell_s=1.0)
@@ -101,8 +102,13 @@ def test_exported_page_plays_the_episode_without_a_server(tmp_path):
     url = (tmp_path / "episode.html").as_uri()
     screenshot(url, tmp_path / "start.png", min_drawn=7, width=WIDTH, height=HEIGHT, animation_time=0.5)
     screenshot(url, tmp_path / "end.png", min_drawn=7, width=WIDTH, height=HEIGHT, animation_time=page["seconds"])
-    first, last = masks(tmp_path / "start.png"), masks(tmp_path / "end.png")
+    screenshot(url, tmp_path / "plain.png", min_drawn=7, width=WIDTH, height=HEIGHT)  # no seeking: as it opens
+    first, last, plain = (masks(tmp_path / f"{name}.png") for name in ("start", "end", "plain"))
     assert np.linalg.norm(centroid(first["red"]) - project(start)) < 45
     assert np.linalg.norm(centroid(last["red"]) - project(moved)) < 45
     assert first["yellow"].sum() < 20 < last["yellow"].sum(), "the asked box is highlighted once asked"
     assert last["green"].sum() > 300 and last["magenta"].sum() > 300
+    # Issue 23 case 8: the page opens at the episode's end (the last question's highlight, the box moved),
+    # not somewhere in its motion.
+    assert np.linalg.norm(centroid(plain["red"]) - project(moved)) < 45, "the page does not open at the end"
+    assert plain["yellow"].sum() > 20, "the page opens without the last question's highlight"
