@@ -6,7 +6,7 @@ VENV ?= .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.teachbot-installed
 
-.PHONY: demo test lint clean
+.PHONY: demo test lint clean experiments
 
 $(STAMP): pyproject.toml
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
@@ -26,3 +26,8 @@ test: $(STAMP)
 
 clean:
 	rm -rf $(VENV) runs .pytest_cache .ruff_cache .mypy_cache
+
+# Rerun every suite the docs cite (docs/experiments.toml) and rewrite every results table in
+# docs/experiments.md and the README from that run, each stamped with the commit and command.
+experiments: $(STAMP)
+	$(PY) scripts/experiments.py

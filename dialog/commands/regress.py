@@ -127,7 +127,12 @@ def run(args: argparse.Namespace) -> int:
 
 def run_on_data_seeds(args: argparse.Namespace, kind, suite, original, out: Path) -> int:
     """--data-seeds: one run per data seed, each with its report, then the findings pooled over all of them."""
-    from dialog.experiments.data_seeds import pooled_findings, replication_report
+    from dialog.experiments.data_seeds import (
+        pooled_findings,
+        replication_report,
+        replication_summary,
+        write_replication_json,
+    )
 
     seeds = list(dict.fromkeys(args.data_seeds))
     if len(seeds) != len(args.data_seeds):
@@ -158,6 +163,7 @@ def run_on_data_seeds(args: argparse.Namespace, kind, suite, original, out: Path
     command = shlex.join(words)
     with writing(out, "results", inside=True):
         path = replication_report(suite, runs, pooled, out, command)
+        write_replication_json(replication_summary(suite, runs, pooled, command), out)
     print(f"pooled over data seeds {', '.join(map(str, seeds))}: {path}")
     for outcome in pooled:
         print(f"  {outcome.finding.id}: {outcome.verdict}")

@@ -5,16 +5,22 @@ report in ``data-seed-N/``). The pooled test pairs every episode two
 strategies share across all the data seeds (unit: the episode pair; the
 interval resamples the training pools of every data seed, the independent
 units), with Holm's correction over the suite's findings as in one run.
-``replication.md`` puts each finding's verdict per data seed beside the pooled one.
+``replication.md`` puts each finding's verdict per data seed beside the pooled one;
+``replication.json`` holds the same numbers for ``scripts/experiments.py``, which
+writes the docs' tables from it.
 """
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
-from dialog.experiments.analysis import FindingResult, evaluate_findings, summarise
+import numpy as np
+
+from bullet_world.catalogue import load_task
+from dialog.experiments.analysis import FindingResult, evaluate_findings, group_results, summarise
 from dialog.experiments.kinds import SuiteRun
-from dialog.experiments.report import _fmt_p
+from dialog.experiments.report import _fmt_p, questions_and_demo_share
 from dialog.experiments.suite import Suite
 from learning.significance import PairedComparison
 
@@ -65,3 +71,76 @@ def replication_report(suite: Suite, runs: dict[int, SuiteRun], pooled: list[Fin
     path = out / "replication.md"
     path.write_text("\n".join(lines) + "\n", encoding="utf-8")
     return path
+
+
+def _direction(outcome: FindingResult) -> bool:
+    """Every comparison of the finding points its way (mean difference on the finding's side)."""
+    if outcome.skipped or not outcome.comparisons:
+        return False
+    sign = -1.0 if outcome.finding.alternative == "less" else 1.0
+    return all(sign * (c.mean_a - c.mean_b) > 0 for c in outcome.comparisons)
+
+
+def _finding_cell(outcome: FindingResult) -> dict:
+    if outcome.skipped:
+        return {"tested": False, "why": outcome.skipped}
+    return {"tested": True, "holds": outcome.holds, "direction": _direction(outcome),
+            "p": max(c.p for c in outcome.comparisons),
+            "p_holm": max((c.p if c.p_holm is None else c.p_holm) for c in outcome.comparisons),
+            "pairs": min(getattr(c, "n", 0) for c in outcome.comparisons),
+            "comparisons": [{"than": c.b, "mean": c.mean_a, "mean_than": c.mean_b,
+                             "effect_r": getattr(c, "effect", None), "ci": list(getattr(c, "ci", ()))}
+                            for c in outcome.comparisons]}
+
+
+def _cell(group: list[dict], summary, suite: Suite) -> dict:
+    questions, share = questions_and_demo_share(group, suite)
+    return {"mean": float(summary.mean[-1]), "error": float(summary.error[-1]), "episodes": len(group),
+            "questions": questions, "demo_share": share}
+
+
+def replication_summary(suite: Suite, runs: dict[int, SuiteRun], pooled: list[FindingResult], command: str) -> dict:
+    """The numbers of ``replication.md`` as data: per condition and strategy the accuracy at the condition's
+    last checkpoint (mean ± standard error over episodes), questions and demonstration share, per data seed
+    and pooled; per finding its test per data seed and pooled."""
+    results = [result for run in runs.values() for result in run.data]
+    pooled_groups, pooled_summaries = group_results(results), summarise(results, suite)
+    scene_default = load_task(suite.task).objects_per_scene
+    conditions = []
+    for condition in suite.conditions:
+        rows = []
+        for summary in (s for s in pooled_summaries if s.condition == condition.name):
+            key = (condition.name, summary.strategy)
+            row = {"strategy": summary.strategy, "at": int(summary.checkpoints[-1]) if summary.checkpoints else None,
+                   "pooled": _cell(pooled_groups[key], summary, suite), "by_data_seed": {}}
+            for seed, run in runs.items():
+                mine = next((s for s in run.summaries if (s.condition, s.strategy) == key), None)
+                if mine is not None and mine.checkpoints:
+                    row["by_data_seed"][str(seed)] = _cell(group_results(run.data)[key], mine, suite)
+            rows.append(row)
+        conditions.append({"name": condition.name, "budget": condition.budget, "turns": condition.turns,
+                           "seconds": condition.seconds, "change_every": condition.change_every,
+                           "objects_per_scene": condition.scene_size(scene_default),
+                           "teacher": dict(condition.teacher), "strategies": rows})
+    by_seed = {seed: {o.finding.id: o for o in run.findings} for seed, run in runs.items()}
+    findings = [{"id": o.finding.id, "text": o.finding.text, "condition": o.finding.condition, "at": o.finding.at,
+                 "pooled": _finding_cell(o),
+                 "by_data_seed": {str(s): _finding_cell(by_seed[s][o.finding.id]) for s in runs
+                                  if o.finding.id in by_seed[s]}} for o in pooled]
+    return {"suite": suite.name, "task": suite.task, "axis": suite.axis, "seeds": list(suite.seeds),
+            "datasets": suite.datasets, "data_seeds": sorted(runs), "command": command,
+            "episodes": sum(run.count for run in runs.values()),
+            "seconds": round(sum(run.seconds for run in runs.values()), 2),
+            "conditions": conditions, "findings": findings}
+
+
+def write_replication_json(summary: dict, out: Path) -> Path:
+    path = out / "replication.json"
+    path.write_text(json.dumps(summary, indent=1, default=_plain) + "\n", encoding="utf-8")
+    return path
+
+
+def _plain(value):
+    if isinstance(value, np.generic):
+        return value.item()
+    raise TypeError(f"not JSON: {type(value).__name__}")

@@ -38,6 +38,14 @@ def write_episode_csvs(results: list[dict], out: Path) -> Path:
     return summary_path
 
 
+def questions_and_demo_share(group: list[dict], suite: Suite) -> tuple[float, float]:
+    """Mean questions asked per episode, and the mean share of the spent budget that went on demonstrations."""
+    questions = float(np.mean([r["series"]["questions"][-1] for r in group]))
+    share = float(np.mean([r["series"]["demo"][-1] * suite.costs.get("demo", 2) / max(r["series"]["spent"][-1], 1e-9)
+                           for r in group]))
+    return questions, share
+
+
 def _fmt_p(p: float) -> str:
     """A p value: 3 significant digits, scientific below 1e-4 (one format for the whole column)."""
     return f"{p:.3g}" if p >= 1e-4 else f"{p:.1e}"
@@ -157,9 +165,7 @@ def markdown_report(suite: Suite, results: list[dict], summaries: list[Checkpoin
                   + " | questions | demo share |", "|---" * (len(checkpoints) + 3 + len(used)) + "|"]
         for summary in rows:
             group = groups[(condition.name, summary.strategy)]
-            questions = np.mean([r["series"]["questions"][-1] for r in group])
-            demo_cost = np.mean([r["series"]["demo"][-1] * suite.costs.get("demo", 2) /
-                                 max(r["series"]["spent"][-1], 1e-9) for r in group])
+            questions, demo_cost = questions_and_demo_share(group, suite)
             cells = " | ".join(f"{m:.3f} ± {e:.3f}" for m, e in zip(summary.mean, summary.error))
             if condition.seconds is not None:  # embodied costs: how many turns and seconds the episodes took
                 turns = np.mean([r["series"]["turn"][-1] for r in group])

@@ -1,0 +1,228 @@
+"""``make experiments``: rerun every suite the docs cite and rewrite every results table from that run.
+
+    python scripts/experiments.py                  # run docs/experiments.toml, then rewrite the docs' tables
+    python scripts/experiments.py --render         # rewrite the tables from the last run's files only
+    python scripts/experiments.py --suites ch7 ... # only these runs (the others' tables are left alone)
+
+Each run is a ``teachbot regress`` command (episodes suites with ``--data-seeds``);
+results go to ``results/experiments/SUITE/``, and ``results/experiments/manifest.json``
+records the commit, the commands, the machine's cores and every wall time. Every
+table is written between its markers with a stamp line naming that commit and
+command (``dialog/experiments/doc_tables.py``). A run refuses a tree with
+uncommitted changes to the code (``--allow-dirty`` runs anyway and the stamps say so).
+"""
+
+from __future__ import annotations
+
+import argparse
+import datetime
+import json
+import os
+import shlex
+import shutil
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+
+from dialog.experiments.doc_tables import (  # noqa: E402
+    Plan,
+    findings_table,
+    load_plan,
+    report_findings,
+    report_tables,
+    results_table,
+    splice,
+    stamp,
+)
+from learning.errors import SettingsError  # noqa: E402
+
+CODE = ("learning", "dialog", "bullet_world", "robot", "pyproject.toml")
+EPISODE_SUITES_REFUSING_DATA_SEEDS = ("ch5", "recipes")  # other kinds: one run on their own data
+
+
+def git(*words: str) -> str:
+    return subprocess.run(["git", *words], cwd=ROOT, capture_output=True, text=True, check=True).stdout.strip()
+
+
+def command_for(run, plan: Plan, results: Path) -> list[str]:
+    shown = os.path.relpath(results, ROOT) if results.resolve().is_relative_to(ROOT) else str(results)
+    words = ["teachbot", "regress", "--suite", run.suite, "--results", shown, "--no-progress", "--json"]
+    if run.suite not in EPISODE_SUITES_REFUSING_DATA_SEEDS:
+        words += ["--data-seeds", *map(str, plan.data_seeds), "--seeds", *map(str, plan.seeds)]
+    if run.strategies:
+        words += ["--strategies", *run.strategies]
+    return words
+
+
+def run_all(plan: Plan, only: list[str] | None, out: Path, allow_dirty: bool) -> dict:
+    dirty = bool(git("status", "--porcelain", "--", *CODE))
+    if dirty and not allow_dirty:
+        raise SettingsError("the code has uncommitted changes (git status -- " + " ".join(CODE) + "): commit "
+                            "first, so that the stamps name the code that made the tables, or give --allow-dirty")
+    manifest_path = out / "manifest.json"
+    manifest = json.loads(manifest_path.read_text()) if manifest_path.exists() and only else {"runs": {}}
+    manifest.update({"commit": git("rev-parse", "HEAD"), "dirty": dirty, "cores": os.cpu_count(),
+                     "date": datetime.date.today().isoformat()})
+    started = time.perf_counter()
+    for run in plan.runs:
+        if only and run.suite not in only:
+            continue
+        results = out / run.suite
+        if results.exists():
+            shutil.rmtree(results)
+        words = command_for(run, plan, results)
+        print(f"$ {shlex.join(words)}", flush=True)
+        began = time.perf_counter()
+        words[words.index("--results") + 1] = str(results)  # run with the full path, show the short one
+        done = subprocess.run([sys.executable, "-m", "dialog.cli", *words[1:]], cwd=ROOT, text=True,
+                              stdout=subprocess.PIPE)
+        seconds = time.perf_counter() - began
+        print(done.stdout[-2000:], flush=True)
+        if done.returncode != 0:
+            raise SystemExit(f"experiments: '{shlex.join(words)}' failed with exit code {done.returncode}")
+        summary = json.loads(done.stdout.strip().splitlines()[-1])
+        manifest["runs"][run.suite] = {"command": shlex.join(command_for(run, plan, results)),
+                                       "wall_seconds": round(seconds, 1),
+                                       "episodes": summary.get("episodes"), "commit": manifest["commit"],
+                                       "dirty": dirty}
+        print(f"  {run.suite}: {seconds:.0f} s", flush=True)
+    manifest["wall_seconds"] = round(time.perf_counter() - started, 1) + (
+        sum(r["wall_seconds"] for s, r in manifest["runs"].items() if only and s not in only))
+    out.mkdir(parents=True, exist_ok=True)
+    manifest_path.write_text(json.dumps(manifest, indent=1) + "\n")
+    return manifest
+
+
+def tables_from(plan: Plan, manifest: dict, out: Path) -> dict[str, str]:
+    """Every table this run can write, keyed by block name, each with its stamp."""
+    tables, replications, reports = {}, {}, {}
+    for run in plan.runs:
+        record = manifest["runs"].get(run.suite)
+        if record is None:
+            continue
+        line = stamp({**manifest, "commit": record["commit"], "dirty": record["dirty"]}, record["command"])
+        folder = out / run.suite
+        figures = _copy_figures(run, folder)
+        if (folder / "replication.json").exists():
+            replications[run.suite] = json.loads((folder / "replication.json").read_text())
+            tables[f"{run.suite}:results"] = results_table(replications[run.suite]) + figures + "\n\n" + line
+            tables[f"{run.suite}:findings"] = findings_table(replications[run.suite]) + "\n\n" + line
+        else:
+            reports[run.suite] = (folder / "report.md").read_text(encoding="utf-8")
+            tables[f"{run.suite}:report"] = report_tables(reports[run.suite]) + figures + "\n\n" + line
+    overall = stamp(manifest, "make experiments")
+    tables["summary:findings"] = summary_findings(plan, replications, reports) + "\n\n" + overall
+    tables["summary:demo-share"] = demo_shares(plan, replications) + "\n\n" + overall
+    tables["summary:wall-times"] = wall_times(manifest) + "\n\n" + overall
+    return tables
+
+
+def _copy_figures(run, folder: Path) -> str:
+    lines = []
+    for name, target, caption in run.figures:
+        source = next(iter(sorted(folder.glob(f"data-seed-*/{name}"))), folder / name)
+        if source.exists():
+            destination = ROOT / "docs" / "img" / "experiments" / target
+            destination.parent.mkdir(parents=True, exist_ok=True)
+            shutil.copyfile(source, destination)
+            lines.append(f"![{caption}](img/experiments/{target})")
+    return ("\n\n" + "\n\n".join(lines)) if lines else ""
+
+
+def summary_findings(plan: Plan, replications: dict, reports: dict) -> str:
+    """Item 7: every thesis finding of every suite in one table."""
+    lines = ["| suite | finding | points its way on data seeds | pooled verdict (Holm p) |", "|---|---|---|---|"]
+    for run in plan.runs:
+        if run.suite in replications:
+            rep = replications[run.suite]
+            for finding in rep["findings"]:
+                cells = [c for c in finding["by_data_seed"].values() if c["tested"]]
+                pooled = finding["pooled"]
+                verdict = ("not tested: " + pooled["why"]) if not pooled["tested"] else \
+                    f"{'**holds**' if pooled['holds'] else 'does not hold'} ({_p(pooled['p_holm'])})"
+                lines.append(f"| {run.suite} | {finding['id']}: {finding['text']} | "
+                             f"{sum(c['direction'] for c in cells)} of {len(cells)} | {verdict} |")
+        elif run.suite in reports:
+            for finding in report_findings(reports[run.suite]):
+                lines.append(f"| {run.suite} | {finding['id']}: {finding['text']} | (one data set) | "
+                             f"{'**holds**' if finding['holds'] else 'does not hold'} |")
+    return "\n".join(lines)
+
+
+def demo_shares(plan: Plan, replications: dict) -> str:
+    """DT's demonstration share per condition beside the thesis's figure (§6.6)."""
+    lines = ["| suite / condition | thesis (DT) | dt-iros | dt-task | dt-task-env |", "|---|---:|---:|---:|---:|"]
+    for key, thesis in plan.thesis_demo_share.items():
+        suite, _, condition = key.partition("/")
+        rows = next((c["strategies"] for c in replications.get(suite, {}).get("conditions", [])
+                     if c["name"] == condition), [])
+        share = {r["strategy"]: r["pooled"]["demo_share"] for r in rows}
+        lines.append(f"| {key} | {thesis:.0%} | " + " | ".join(
+            f"{share[s]:.0%}" if s in share else "–" for s in ("dt-iros", "dt-task", "dt-task-env")) + " |")
+    return "\n".join(lines)
+
+
+def wall_times(manifest: dict) -> str:
+    lines = ["| suite | command | episodes or runs | wall time |", "|---|---|---:|---:|"]
+    for suite, record in manifest["runs"].items():
+        lines.append(f"| {suite} | `{record['command']}` | {record.get('episodes') or '–'} | "
+                     f"{record['wall_seconds']:.0f} s |")
+    lines.append(f"| all | `make experiments` | | {manifest.get('wall_seconds', 0):.0f} s |")
+    return "\n".join(lines)
+
+
+def _p(p: float) -> str:
+    return f"{p:.3g}" if p >= 1e-4 else f"{p:.1e}"
+
+
+def render(plan: Plan, manifest: dict, out: Path) -> list[str]:
+    tables = tables_from(plan, manifest, out)
+    written = []
+    for doc in plan.docs:
+        path = ROOT / doc
+        text, replaced = splice(path.read_text(encoding="utf-8"), tables)
+        path.write_text(text, encoding="utf-8")
+        written += [f"{doc}: {name}" for name in replaced]
+    return written
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--plan", type=Path, default=ROOT / "docs" / "experiments.toml")
+    parser.add_argument("--results", type=Path, default=ROOT / "results" / "experiments")
+    parser.add_argument("--render", action="store_true", help="only rewrite the tables from the last run's files")
+    parser.add_argument("--suites", nargs="+", default=None, help="only these runs of the plan")
+    parser.add_argument("--allow-dirty", action="store_true", help="run with uncommitted code changes")
+    parser.add_argument("--json", action="store_true", help="end with one JSON line: the manifest")
+    args = parser.parse_args(argv)
+    try:
+        plan = load_plan(args.plan)
+        unknown = sorted(set(args.suites or []) - {run.suite for run in plan.runs})
+        if unknown:
+            raise SettingsError(f"--suites: {', '.join(unknown)} not in {args.plan} "
+                                f"({', '.join(r.suite for r in plan.runs)})")
+        if args.render:
+            manifest_path = args.results / "manifest.json"
+            if not manifest_path.exists():
+                raise SettingsError(f"{manifest_path}: no run to render from (run without --render first)")
+            manifest = json.loads(manifest_path.read_text())
+        else:
+            manifest = run_all(plan, args.suites, args.results, args.allow_dirty)
+        for line in render(plan, manifest, args.results):
+            print(f"wrote {line}")
+    except SettingsError as error:
+        print(f"experiments: {error}", file=sys.stderr)
+        return 2
+    print(f"experiments: {len(manifest['runs'])} runs, {manifest.get('wall_seconds', 0):.0f} s, commit "
+          f"{manifest['commit'][:10]}")
+    if args.json:
+        print(json.dumps(manifest))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
