@@ -118,6 +118,7 @@ def tables_from(plan: Plan, manifest: dict, out: Path) -> dict[str, str]:
     tables["summary:findings"] = summary_findings(plan, replications, reports) + "\n\n" + overall
     tables["summary:demo-share"] = demo_shares(plan, replications) + "\n\n" + overall
     tables["summary:wall-times"] = wall_times(manifest) + "\n\n" + overall
+    tables["summary:suites"] = suites_table(plan, manifest, replications, reports) + "\n\n" + overall
     return tables
 
 
@@ -163,6 +164,25 @@ def demo_shares(plan: Plan, replications: dict) -> str:
         share = {r["strategy"]: r["pooled"]["demo_share"] for r in rows}
         lines.append(f"| {key} | {thesis:.0%} | " + " | ".join(
             f"{share[s]:.0%}" if s in share else "–" for s in ("dt-iros", "dt-task", "dt-task-env")) + " |")
+    return "\n".join(lines)
+
+
+def suites_table(plan: Plan, manifest: dict, replications: dict, reports: dict) -> str:
+    """The README's table: each suite's size, wall time and how many of its findings hold (pooled)."""
+    lines = ["| suite | episodes or runs | wall time | findings that hold (pooled over the data seeds) |",
+             "|---|---:|---:|---|"]
+    for run in plan.runs:
+        record = manifest["runs"].get(run.suite)
+        if record is None:
+            continue
+        if run.suite in replications:
+            outcomes = [(f["id"], f["pooled"].get("holds", False)) for f in replications[run.suite]["findings"]
+                        if f["pooled"]["tested"]]
+        else:
+            outcomes = [(f["id"], f["holds"]) for f in report_findings(reports.get(run.suite, ""))]
+        held = [name for name, holds in outcomes if holds]
+        lines.append(f"| {run.suite} | {record.get('episodes') or '–'} | {record['wall_seconds']:.0f} s | "
+                     f"{len(held)} of {len(outcomes)}" + (f": {', '.join(held)}" if held else "") + " |")
     return "\n".join(lines)
 
 

@@ -26,7 +26,7 @@ from learning.errors import SettingsError
 BEGIN = re.compile(r"<!-- experiments:begin (?P<name>[\w.:-]+) -->")
 END = "<!-- experiments:end {name} -->"
 STAMP_PREFIX = "<sub>Made by `make experiments`"
-SUMMARIES = ("summary:findings", "summary:demo-share", "summary:wall-times")
+SUMMARIES = ("summary:findings", "summary:demo-share", "summary:wall-times", "summary:suites")
 PARTS = ("results", "findings", "report")
 
 
