@@ -9,9 +9,9 @@ clicks (a concept button, an object's number button, the feature checkboxes);
 for every answer the time from the click to the next question being shown and
 waiting in the page is measured (and, of it, the time until the question's
 message reached the browser), and the page's load time (from opening the URL
-to the first question ready to answer, 3D view included). Then the same answers
-are typed into ``teachbot teach`` at a pseudo-terminal, and the time from
-Enter to the next prompt is measured the same way. Both include the robot's own
+to the first question ready to answer and, with the 3D view, drawn in it).
+Then the same answers are typed into ``teachbot teach`` at a pseudo-terminal,
+and the time from Enter to the next prompt is measured the same way. Both include the robot's own
 work between the questions (the strategy's decision, the arm's pointing);
 the difference is what the page costs. Goal: page p95 under 300 ms beside a DT
 decision, i.e. the page adds less than 300 ms to the terminal's p95.
@@ -38,10 +38,64 @@ from dialog.transcript import read_session
 TEACHBOT = str(Path(sys.executable).with_name("teachbot"))
 GOAL_MS = 300.0
 QUESTION = re.compile(r"(Which features tell|Can you show me|What is the)")
+# The page is ready: its first question waits for the answer and, with the 3D view, the view has drawn it with
+# the arm's meshes and every object in it (and nothing newer waits to be drawn).
+READY = """() => {
+    const drawn = (name) => { const node = viewer.scene.getObjectByName(name); let mesh = false;
+                              if (node) { node.traverse((o) => { mesh = mesh || Boolean(o.isMesh); }); } return mesh; };
+    return Boolean(question && waiting && (!viewer || (drawn3d === question.id && !viewer.needs_render
+        && Object.keys(objectNodes).length > 0 && [...Object.keys(objectNodes), "robot"].every(drawn))));
+}"""
+
+
+def processes(roots: list[int]) -> dict[int, str]:
+    """Every process under ``roots`` (Linux /proc), named by its part: the session (teachbot and its meshcat
+    server), Chromium's GPU process (where WebGL is drawn), its page (renderer), the rest of the browser, or
+    playwright's driver."""
+    parents = {}
+    for entry in Path("/proc").iterdir():
+        try:
+            parents[int(entry.name)] = int((entry / "stat").read_text().rsplit(")", 1)[1].split()[1])
+        except (ValueError, OSError, IndexError):
+            continue
+    found, frontier = {}, list(roots)
+    while frontier:
+        pid = frontier.pop()
+        try:
+            line = Path(f"/proc/{pid}/cmdline").read_bytes().replace(b"\0", b" ").decode("utf-8", "replace")
+        except OSError:
+            continue
+        kind = re.search(r"--type=([a-z-]+)", line)
+        found[pid] = ("browser_gpu" if kind and kind.group(1) == "gpu-process" else
+                      "browser_page" if kind and kind.group(1) == "renderer" else
+                      "browser_other" if "chrom" in line else "driver" if "playwright" in line else "session")
+        frontier += [child for child, parent in parents.items() if parent == pid and child not in found]
+    return found
+
+
+def cpu_seconds(named: dict[int, str]) -> dict[int, float]:
+    tick = os.sysconf("SC_CLK_TCK")
+    used = {}
+    for pid in named:
+        try:
+            fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        used[pid] = (int(fields[11]) + int(fields[12])) / tick  # user and system time
+    return used
+
+
+def cpu_by_part(named: dict[int, str], before: dict[int, float], after: dict[int, float]) -> dict[str, float]:
+    parts = dict.fromkeys(("session", "browser_gpu", "browser_page", "browser_other"), 0.0)
+    for pid, seconds in after.items():
+        if named[pid] in parts:  # not playwright's driver: it only clicks
+            parts[named[pid]] += seconds - before.get(pid, 0.0)
+    return {part: round(seconds, 2) for part, seconds in parts.items()}
 
 
 def web_session(args, folder: Path) -> dict:
-    """Answer a --web session by clicks; the click-to-question times and the page's load time."""
+    """Answer a --web session by clicks; the click-to-question times, the page's load time, and over the
+    answered turns the CPU seconds of each part, the 3D frames drawn and the wall seconds."""
     from playwright.sync_api import sync_playwright
 
     command = [TEACHBOT, "teach", "--web", "--seed", str(args.seed), "--turns", str(args.turns), "--strategy",
@@ -73,8 +127,12 @@ def web_session(args, folder: Path) -> dict:
             page.on("websocket", watch)
             started = time.perf_counter()
             page.goto(url)
-            page.wait_for_function("() => question && waiting", timeout=120_000)
+            page.wait_for_function(READY, timeout=120_000, polling=5)
             load_ms = (time.perf_counter() - started) * 1000
+            named = processes([process.pid, os.getpid()])
+            named.pop(os.getpid(), None)  # this script's own driving is neither the session nor the page
+            frames = "() => viewer ? viewer.renderer.info.render.frame : 0"
+            cpu_before, frames_before, turns_started = cpu_seconds(named), page.evaluate(frames), time.perf_counter()
             while True:
                 question = page.evaluate("() => question")
                 clicked = time.perf_counter()
@@ -90,6 +148,8 @@ def web_session(args, folder: Path) -> dict:
                                        arg=question["id"], timeout=120_000, polling=5)
                 shown = time.perf_counter()
                 if page.evaluate("() => ended"):
+                    cpu = cpu_by_part(named, cpu_before, cpu_seconds(named))
+                    frames_3d, wall_s = page.evaluate(frames) - frames_before, time.perf_counter() - turns_started
                     break
                 times.append((shown - clicked) * 1000)
                 arrivals.append((received.get(page.evaluate("() => question.id"), shown) - clicked) * 1000)
@@ -98,7 +158,8 @@ def web_session(args, folder: Path) -> dict:
     finally:
         if process.poll() is None:
             process.kill()
-    return {"click_to_question_ms": times, "click_to_arrival_ms": arrivals, "page_load_ms": load_ms}
+    return {"click_to_question_ms": times, "click_to_arrival_ms": arrivals, "page_load_ms": load_ms,
+            "cpu_seconds": cpu, "frames_3d": frames_3d, "wall_s": round(wall_s, 1)}
 
 
 def terminal_session(args, folder: Path, lines: list[str]) -> list[float]:
@@ -155,7 +216,9 @@ def main(argv=None) -> int:
               "page_click_to_question_ms": page, "page_click_to_arrival_ms": arrival,
               "terminal_enter_to_question_ms": at_terminal,
               "page_load_ms": round(web["page_load_ms"], 1), "page_p95_overhead_ms": overhead,
-              "goal_ms": GOAL_MS, "goal_met": page["p95"] < at_terminal["p95"] + GOAL_MS}
+              "goal_ms": GOAL_MS, "goal_met": page["p95"] < at_terminal["p95"] + GOAL_MS,
+              "page_turns_wall_s": web["wall_s"], "page_turns_cpu_s": web["cpu_seconds"],
+              "page_turns_3d_frames": web["frames_3d"], "load_average": [round(v, 2) for v in os.getloadavg()]}
     print(f"{args.turns} turns of {args.strategy}, seed {args.seed}, 3D view {'off' if args.no_3d else 'on'} "
           f"(the same questions at both: {same})")
     print(f"page:     click to next question  p50 {page['p50']:.0f} ms  p95 {page['p95']:.0f} ms  "
@@ -164,8 +227,13 @@ def main(argv=None) -> int:
           f"p95 {arrival['p95']:.0f} ms (the rest: the page showing it)")
     print(f"terminal: Enter to next question  p50 {at_terminal['p50']:.0f} ms  p95 {at_terminal['p95']:.0f} ms  "
           f"max {at_terminal['max']:.0f} ms  (n={at_terminal['n']})")
+    drawn = "" if args.no_3d else ", drawn in the 3D view"
     print(f"the page adds {overhead:.0f} ms at p95 (goal: under {GOAL_MS:.0f} ms); page load "
-          f"{web['page_load_ms']:.0f} ms (to the first question ready{', 3D view included' if not args.no_3d else ''})")
+          f"{web['page_load_ms']:.0f} ms (to the first question ready{drawn})")
+    cpu = web["cpu_seconds"]
+    print(f"over the page's {web['wall_s']:.1f} s of turns: CPU s session {cpu['session']:.2f}, browser GPU process "
+          f"{cpu['browser_gpu']:.2f}, page {cpu['browser_page']:.2f}, rest {cpu['browser_other']:.2f}; "
+          f"3D frames drawn {web['frames_3d']}; load average {result['load_average'][0]:.2f}")
     if args.json:
         print(json.dumps(result))
     return 0

@@ -54,6 +54,15 @@ class MeshcatThread:
         self._wake.set()
         return future
 
+    def drain(self, timeout_s: float) -> bool:
+        """Wait until everything queued so far is applied (meshcat's server has taken it); False if that takes
+        longer than ``timeout_s`` (the caller goes on either way)."""
+        try:
+            self.submit(lambda: None).result(timeout=timeout_s)
+        except Exception:  # a timeout, or the thread stopped: nothing to wait for
+            return False
+        return True
+
     def start_live(self, camera: tuple, timeout_s: float, reply_timeout_s: float = 10.0) -> str:
         """Start the loopback server and the live scene; returns the page's URL. The server must answer
         each batch of commands within ``reply_timeout_s``, or the live view stops."""

@@ -53,6 +53,7 @@ def check_web_options(args: argparse.Namespace) -> None:
 
 
 WAIT_FOR_PAGE_S = 60.0
+MIRROR_WAIT_S = 2.0  # the longest a question waits for the 3D view's mirror (a stuck meshcat server stops it)
 
 
 class Watcher:
@@ -141,6 +142,13 @@ class WebPage:
         if self.viewer is not None:
             nodes = {node.rsplit("/", 1)[-1]: index + 1 for index, node in enumerate(self.viewer.reader.object_nodes)}
             self.teacher.set_nodes(nodes)
+
+    def on_question(self, action=None, text=None, scene=None) -> None:
+        """Before the question goes to the page: the 3D view's mirror (an observer before this one) hands meshcat
+        the arm's final pose and the question's highlight first, so that the page gets them with the question
+        and draws them at once, in one frame, instead of piece by piece after it."""
+        if self.viewer is not None and self.viewer.thread.live:
+            self.viewer.thread.drain(MIRROR_WAIT_S)
 
     def wait_for_viewer_page(self, timeout_s: float = WAIT_FOR_PAGE_S) -> bool:
         """Wait until a browser has the page open (a demo should not end before anyone sees it); False if none

@@ -5,6 +5,7 @@ from __future__ import annotations
 import base64
 import re
 import socket
+import threading
 from pathlib import Path
 from types import SimpleNamespace
 
@@ -322,6 +323,24 @@ def test_a_live_view_that_dies_warns_once_and_the_session_goes_on(bare, capsys):
         viewer.close()
     warnings = capsys.readouterr().err.strip().splitlines()
     assert len(warnings) == 1 and "the session goes on without the live view" in warnings[0]
+
+
+def test_drain_waits_until_meshcat_has_the_question_and_gives_up_after_its_time(bare):
+    bare.three_objects()
+    viewer = Viewer(bare)
+    try:
+        assert viewer.thread.drain(60)
+        before = dict(viewer.thread.scene.sent)
+        viewer.on_question({"kind": "label", "object": 1}, "What is this (object 1)?")
+        assert viewer.thread.drain(60)
+        assert viewer.thread.scene.sent["objects"] > before["objects"]  # the highlight and the texts: sent
+        release = threading.Event()
+        viewer.thread.submit(release.wait)  # a meshcat thread that is stuck
+        assert not viewer.thread.drain(0.2)
+        release.set()
+        assert viewer.thread.drain(60)
+    finally:
+        viewer.close()
 
 
 def test_observer_highlights_the_asked_object_and_shows_the_dialog(bare):

@@ -182,6 +182,7 @@ function sendFeatures(mode) {
 }
 
 function setWaiting(on) {
+  if (waiting && !on) { busySince = performance.now(); }
   waiting = Boolean(on) && !ended;
   document.querySelectorAll("#ask button, #ask input").forEach((element) => { element.disabled = !waiting; });
   if (waiting && question) { status(`Turn ${question.turn}: your answer, please`); }
@@ -279,11 +280,34 @@ function start3d(which) {
   $("view3d").replaceChildren();
   viewer = null;
   if (!which || typeof MeshCat === "undefined") { return; }
-  viewer = new MeshCat.Viewer($("view3d"));
+  viewer = new MeshCat.Viewer($("view3d"), true, renderer3d());
   if (viewer.gui) { viewer.gui.close(); }
   fit3d();
   throttle3d();
   viewer.connect(`${WS_BASE}/meshcat-ws?token=${encodeURIComponent(TOKEN)}&view=${which}`);
+}
+
+function softwareWebGL() {
+  // whether WebGL is drawn by the CPU (SwiftShader, llvmpipe: a browser without a GPU), where every frame of the
+  // arm's 100,000 triangles costs a core a fifth of a second
+  const canvas = document.createElement("canvas");
+  const gl = canvas.getContext("webgl");
+  if (!gl) { return false; }
+  const info = gl.getExtension("WEBGL_debug_renderer_info");
+  const name = info ? String(gl.getParameter(info.UNMASKED_RENDERER_WEBGL)) : "";
+  const lose = gl.getExtension("WEBGL_lose_context");
+  if (lose) { lose.loseContext(); }
+  return /swiftshader|llvmpipe|softpipe|software/i.test(name);
+}
+
+function renderer3d() {
+  // meshcat's own renderer, but without multisampling when the CPU draws (it more than doubles a frame's cost)
+  software3d = softwareWebGL();
+  const renderer = new MeshCat.THREE.WebGLRenderer({antialias: !software3d, alpha: true});
+  renderer.shadowMap.enabled = true;
+  renderer.shadowMap.type = MeshCat.THREE.PCFSoftShadowMap;
+  $("view3d").appendChild(renderer.domElement);
+  return renderer;
 }
 
 // A click in the 3D view: meshcat's orbit controls take the pointer from the canvas, so the press and the
@@ -303,18 +327,32 @@ document.addEventListener("pointerup", (event) => {
   if (number !== null) { send({type: "pick", object: number}); }
 }, true);
 
-const BUSY_3D_FPS = 3;  // while the robot works: a software-rendering browser would take the cores it needs
+const BUSY_3D_FPS = 3;     // while the robot works, with a GPU (and in a watched demo): a few frames a second
+const SOFTWARE_BUSY_MS = 1000;  // without one: at most one frame a second, and none in the first second
+let software3d = false;    // whether the CPU draws the 3D view (softwareWebGL)
+let busySince = 0;         // when the robot began working (the answer was sent)
+let drawn3d = null;        // the last question the 3D view was drawn for while it waited (its id)
 
 function throttle3d() {
-  // meshcat renders on the next animation frame after every change; while the robot is busy (pointing,
-  // deciding), at most BUSY_3D_FPS times a second; while it waits for the answer, freely (orbiting the view)
+  // meshcat renders on the next animation frame after every change. While the robot is busy (pointing, deciding)
+  // the page draws at most BUSY_3D_FPS frames a second. Drawn by the CPU (no GPU) a frame takes a core for a
+  // tenth to a fifth of a second, which the robot needs between an answer and the next question: so there,
+  // while the robot works for an answer, the view is drawn at most once a second and not in the first second
+  // (most turns end sooner). When the question arrives, the view is drawn at once (the arm pointing, the
+  // highlight), and freely while the question waits (orbiting the view).
   const render = viewer.render.bind(viewer);
   let last = 0;
   viewer.render = () => {
     const now = performance.now();
-    if (!waiting && now - last < 1000 / BUSY_3D_FPS) { viewer.needs_render = true; return; }
+    const held = software3d && !(question && question.watch)  // a watched demo has no answers to wait for
+      ? now - Math.max(last, busySince) < SOFTWARE_BUSY_MS : now - last < 1000 / BUSY_3D_FPS;
+    if (!waiting && !ended && held) {
+      viewer.needs_render = true;
+      return;
+    }
     last = now;
     render();
+    if (waiting && question) { drawn3d = question.id; }
   };
 }
 
