@@ -143,6 +143,7 @@ class DiscreteFeatures:
         self._feature_su: np.ndarray | None = None
         self._su_rows: dict[int, np.ndarray] = {}
         self._class_tables: dict[bytes, tuple] = {}
+        self._signatures: list[bytes] | None = None
 
     def _entropy(self, one_hot: np.ndarray, starts: np.ndarray) -> np.ndarray:
         return _joint_entropies(np.ones((self.n_samples, 1)), one_hot, starts)[0]
@@ -218,6 +219,21 @@ class DiscreteFeatures:
         return self._su_rows[feature]
 
 
+    def partition_signatures(self) -> list[bytes]:
+        """Per feature, its partition of the samples as bytes (bins renamed in order of first appearance).
+
+        Computed once for every feature (ES asks for it once per concept): equal signatures are exact copies.
+        """
+        if self._signatures is None:
+            codes = self.codes
+            values = np.arange(int(codes.max(initial=0)) + 1)[:, None, None]
+            is_value = codes[None, :, :] == values  # (value, sample, feature)
+            first_seen = np.where(is_value.any(axis=1), is_value.argmax(axis=1), codes.shape[0])
+            rank_of_value = np.argsort(np.argsort(first_seen, axis=0, kind="stable"), axis=0, kind="stable")
+            canonical = np.take_along_axis(rank_of_value, codes, axis=0).T.astype(np.int16)  # bins renamed
+            self._signatures = [partition.tobytes() for partition in canonical]
+        return self._signatures
+
 class LazyCorrelations:
     """Feature-feature SU rows on demand: what ES reads of the matrix (rows of chosen features)."""
 
@@ -233,16 +249,11 @@ class LazyCorrelations:
         Two features are exact copies (SU = 1) exactly when their bins partition the samples the same
         way; comparing partitions (bins renamed in order of first appearance) finds them without SU rows.
         """
-        codes = self.table.codes[:, features]
-        values = np.arange(int(codes.max(initial=0)) + 1)[:, None, None]
-        is_value = codes[None, :, :] == values  # (value, sample, feature)
-        first_seen = np.where(is_value.any(axis=1), is_value.argmax(axis=1), codes.shape[0])
-        rank_of_value = np.argsort(np.argsort(first_seen, axis=0, kind="stable"), axis=0, kind="stable")
-        canonical = np.take_along_axis(rank_of_value, codes, axis=0).T.astype(np.int16)  # bins renamed
+        signatures = self.table.partition_signatures()
         seen: set[bytes] = set()
         keep = np.zeros(len(features), dtype=bool)
-        for column, partition in enumerate(canonical):
-            signature = partition.tobytes()
+        for column, feature in enumerate(features):
+            signature = signatures[int(feature)]
             keep[column] = signature not in seen
             seen.add(signature)
         return keep
