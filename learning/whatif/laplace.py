@@ -196,7 +196,6 @@ def fit_modes(kernels: np.ndarray, targets: np.ndarray, kernel_of_row: np.ndarra
     kernels32 = kernels.astype(np.float32)
     positive = (targets + 1.0) / 2.0
     f = np.zeros((n_rows, n)) if start is None else np.array(start, dtype=float)
-    identity = np.eye(n, dtype=np.float32)
     sw = np.empty((n_rows, n))
     factors = np.empty((n_rows, n, n), dtype=np.float32)
     factored_at = np.empty((n_rows, n))
@@ -214,7 +213,9 @@ def fit_modes(kernels: np.ndarray, targets: np.ndarray, kernel_of_row: np.ndarra
             pi = sigmoid(f[row])
             sw[row] = np.sqrt(pi * (1.0 - pi))
             weights = sw[row].astype(np.float32)
-            B = identity + weights[:, None] * kernels32[kernel_of_row[row]] * weights[None, :]
+            B = weights[:, None] * kernels32[kernel_of_row[row]]  # B = I + S K S, built in place (one n x n array)
+            B *= weights[None, :]
+            B.flat[:: n + 1] += 1.0
             # B is symmetric, so B.T is the same matrix in the Fortran order LAPACK wants (no copy);
             # the factor comes back in Fortran order and is stored transposed, again without a copy.
             factors[row] = spotrf(B.T, lower=1, clean=0, overwrite_a=1)[0].T
