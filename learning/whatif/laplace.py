@@ -265,11 +265,12 @@ def predict_from_modes(cross_kernels: np.ndarray, variance: float, sw: np.ndarra
 
 
 def pivoted_cholesky(points: np.ndarray, length_scale: float, variance: float, tolerance: float,
-                     max_rank: int) -> np.ndarray | None:
+                     max_rank: int, truncate: bool = False) -> np.ndarray | None:
     """Phi (N, r) with K(points, points) ~ Phi Phi^T, every residual diagonal entry below ``tolerance``.
 
     Greedy pivoted Cholesky: each step takes the point with the largest residual variance. Returns None
-    if ``max_rank`` columns do not reach the tolerance (the kernel is not of low numerical rank).
+    if ``max_rank`` columns do not reach the tolerance (the kernel is not of low numerical rank), or with
+    ``truncate`` those ``max_rank`` columns (a rough approximation, e.g. to start Newton from).
     """
     n_points = len(points)
     if n_points == 0:
@@ -284,7 +285,7 @@ def pivoted_cholesky(points: np.ndarray, length_scale: float, variance: float, t
         if residual[pivot] < tolerance:
             return Phi_T[:k].T
         if k == width:
-            return None
+            return Phi_T.T if truncate else None
         column = np.exp(scale * (norms + norms[pivot] - 2.0 * (points @ points[pivot])))  # k(x, x_pivot) / variance
         column *= variance
         column -= Phi_T[:k, pivot] @ Phi_T[:k]
