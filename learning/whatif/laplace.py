@@ -137,8 +137,18 @@ def one_site_probabilities(posterior: ScenePosterior, max_steps: int = 50, toler
     if posterior.cross is not None:
         assert posterior.mode is not None and posterior.W is not None, "cross, mode and W are set together"
         cross, mode, W = posterior.cross, posterior.mode[:, None, None, :], posterior.W[:, None, None, :]
-        moved = mode + cross.transpose(0, 2, 1)[:, None, :, :] * shift[..., None]  # [g, t, j, n]
-        residual = sigmoid(mode) - sigmoid(moved) + W * (moved - mode)
+        # residual = sigmoid(mode) - sigmoid(moved) + W (moved - mode), moved = mode + Cov(train, j) shift,
+        # on [g, t, j, n] arrays (the largest of the decision) computed in place, the same operations in order
+        moved = cross.transpose(0, 2, 1)[:, None, :, :] * shift[..., None]
+        moved += mode  # [g, t, j, n]
+        residual = np.multiply(moved, 0.5)
+        np.tanh(residual, out=residual)
+        residual += 1.0
+        residual *= 0.5  # sigmoid(moved), as gp.sigmoid
+        np.subtract(sigmoid(mode), residual, out=residual)
+        moved -= mode
+        moved *= W
+        residual += moved
         # Cov(scene, train) r for every (g, t, j), one matrix product per classifier
         along = np.matmul(residual.reshape(n_batch, 2 * m, -1), cross).reshape(n_batch, 2, m, m)
         at_site = np.diagonal(along, axis1=2, axis2=3)  # (g, t, j)
