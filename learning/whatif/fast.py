@@ -213,6 +213,7 @@ def _dense_starts(state, rows, X, targets) -> np.ndarray:
         subset = np.array(key)
         Phi = pivoted_cholesky(X[:, subset], _length_scale(state, subset), state.kernel_variance,
                                LOW_RANK_TOLERANCE * state.kernel_variance, DENSE_START_RANK, truncate=True)
+        assert Phi is not None, "a truncated pivoted Cholesky always returns its columns"
         members = [b for b, (k, _) in enumerate(rows) if k == key]
         z, _ = fit_weight_space(Phi, targets[members])
         start[members] = z @ Phi.T
