@@ -66,6 +66,7 @@ class LearningState:
         self._training_version = 0  # bumps whenever the training set changes
         self.cache: dict = {}  # what-if engines memoise (version, value) entries here; not learning state
         self._scene_P: np.ndarray | None = None
+        self._training_arrays: tuple | None = None  # (examples, X, labels) of training_matrix
         self._seconds = None  # embodied costs: a learning.decision.embodied.SecondsClock (None: time in turns)
         self._refit()
 
@@ -312,10 +313,17 @@ class LearningState:
         return self._models.columns(concept, len(self.feature_names))
 
     def training_matrix(self) -> tuple[np.ndarray, np.ndarray]:
+        """The training rows and their concept names (read-only; built once per training set)."""
         if not self._examples:
             return np.zeros((0, len(self.feature_names))), np.array([], dtype=object)
-        return (np.vstack([e.x for e in self._examples]),
-                np.array([e.concept for e in self._examples], dtype=object))
+        built = self._training_arrays
+        if built is None or built[0] is not self._examples:  # the examples tuple is replaced on every change
+            X = np.vstack([e.x for e in self._examples])
+            labels = np.array([e.concept for e in self._examples], dtype=object)
+            X.setflags(write=False)
+            labels.setflags(write=False)
+            built = self._training_arrays = (self._examples, X, labels)
+        return built[1], built[2]
 
     def scaled_training(self) -> tuple[np.ndarray, np.ndarray]:
         """The training rows as the models see them (standardised) and their concept names."""

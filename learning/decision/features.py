@@ -89,25 +89,37 @@ def label_distribution(P: np.ndarray) -> np.ndarray:
 
 def prediction_margin(P: np.ndarray) -> np.ndarray:
     """PM(s) = mean_x [p(y_1|x) - p(y_2|x)], the top two labels of each scene object (eq. 7.4)."""
-    Q = label_distribution(P)
-    if Q.shape[-2] == 0:
-        return np.zeros(Q.shape[:-2])
-    if Q.shape[-1] == 1:
-        return Q[..., 0].mean(axis=-1)
-    first, second = _top_two(Q)
+    return _prediction_margin(_by_concept(P))
+
+
+def _prediction_margin(columns: np.ndarray) -> np.ndarray:
+    """PM from the (..., |Y|, |X|) layout: the sums and top two over the few concepts run on whole rows
+    (contiguous), the same additions in the same order as ``label_distribution`` over the last axis."""
+    n_concepts, n_objects = columns.shape[-2:]
+    if n_objects == 0:
+        return np.zeros(columns.shape[:-2])
+    total = columns.sum(axis=-2, keepdims=True)
+    if np.all(total > 0):
+        Q = columns / total
+    else:
+        Q = np.where(total > 0, columns / np.where(total > 0, total, 1.0), 1.0 / n_concepts)
+    if n_concepts == 1:
+        return Q[..., 0, :].mean(axis=-1)
+    first, second = _top_two(Q, axis=-2)
     return np.clip((first - second).mean(axis=-1), 0.0, 1.0)
 
 
-def _top_two(Q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The largest and second-largest value along the last axis (the same numbers np.partition picks).
+def _top_two(Q: np.ndarray, axis: int = -1) -> tuple[np.ndarray, np.ndarray]:
+    """The largest and second-largest value along ``axis`` (the same numbers np.partition picks).
 
     One pass over the few concepts with elementwise max/min: a partition of length-|Y| rows costs more
     than the rest of the decision features together.
     """
-    first = np.maximum(Q[..., 0], Q[..., 1])
-    second = np.minimum(Q[..., 0], Q[..., 1])
-    for k in range(2, Q.shape[-1]):
-        column = Q[..., k]
+    Q = np.moveaxis(Q, axis, 0)  # a view: Q[k] is every value of concept k
+    first = np.maximum(Q[0], Q[1])
+    second = np.minimum(Q[0], Q[1])
+    for k in range(2, Q.shape[0]):
+        column = Q[k]
         second = np.maximum(second, np.minimum(first, column))
         first = np.maximum(first, column)
     return first, second
@@ -170,7 +182,7 @@ def learning_features(P: np.ndarray, counts: np.ndarray) -> np.ndarray:
     counts = np.broadcast_to(np.asarray(counts, dtype=float), P.shape[:-2] + (P.shape[-1],))
     columns = _by_concept(P)
     return np.stack([_discriminability(columns), class_uniformity(counts), _instance_variation(columns),
-                     prediction_margin(P)], axis=-1)
+                     _prediction_margin(columns)], axis=-1)
 
 
 def features(P: np.ndarray, counts: np.ndarray, clock: Clock) -> np.ndarray:

@@ -84,7 +84,9 @@ def check_count(value, name: str, minimum: int) -> None:
 def _discretize(features: np.ndarray, n_bins: int) -> np.ndarray:
     """Equal-frequency codes for all columns at once (vectorised; see the module docstring)."""
     n_samples, n_features = features.shape
-    order = np.argsort(features, axis=0, kind="stable")
+    # Ties may sort in any order: equal values get the same rank and bin whatever their order, so the fast
+    # (unstable) sort of the contiguous transposed rows gives the same codes as a stable one, 5x faster.
+    order = np.argsort(features.T, axis=1).T
     ordered = np.take_along_axis(features, order, axis=0)
     # A column with no more distinct values than bins keeps them: code = rank among its distinct values.
     new_value = np.vstack([np.zeros((1, n_features), dtype=np.intp), np.diff(ordered, axis=0) != 0])
@@ -114,8 +116,12 @@ def discretize(X, n_bins: int | None = None) -> np.ndarray:
 
 
 def _joint_entropies(left: np.ndarray, right: np.ndarray, starts: np.ndarray):
-    """Plug-in H(a, b) in bits and occupied cells, one-hot ``left`` vs each block of ``right``."""
-    counts = left.T @ right
+    """Plug-in H(a, b) in bits and occupied cells, one-hot ``left`` vs each block of ``right``.
+
+    ``right`` may be float32: the counts are whole numbers below 2^24, exact in single precision (and the
+    product twice as fast).
+    """
+    counts = (left.T.astype(right.dtype) @ right).astype(np.float64)
     probabilities = counts / left.shape[0]
     terms = -(probabilities * np.log2(np.where(probabilities > 0, probabilities, 1.0))).sum(axis=0)
     return np.add.reduceat(terms, starts), np.add.reduceat((counts > 0).sum(axis=0), starts)
@@ -138,11 +144,13 @@ class DiscreteFeatures:
         self.starts = np.concatenate(([0], np.cumsum(self.levels)[:-1]))
         self.one_hot = np.zeros((self.n_samples, int(self.levels.sum())))
         self.one_hot[np.arange(self.n_samples)[:, None], self.starts + self.codes] = 1.0
-        self.entropies = self._entropy(self.one_hot, self.starts)
+        self.one_hot32 = self.one_hot.astype(np.float32)  # what the count products read
+        self.entropies = self._entropy(self.one_hot32, self.starts)
         self.inverse_bin_sizes = np.add.reduceat(1.0 / self.one_hot.sum(axis=0), self.starts)
         self._feature_su: np.ndarray | None = None
         self._su_rows: dict[int, np.ndarray] = {}
         self._class_tables: dict[bytes, tuple] = {}
+        self._signatures: list[bytes] | None = None
 
     def _entropy(self, one_hot: np.ndarray, starts: np.ndarray) -> np.ndarray:
         return _joint_entropies(np.ones((self.n_samples, 1)), one_hot, starts)[0]
@@ -156,7 +164,7 @@ class DiscreteFeatures:
         key = class_codes.tobytes()
         if key not in self._class_tables:
             class_one_hot = np.eye(int(class_codes.max()) + 1)[class_codes]
-            joint, cells = _joint_entropies(class_one_hot, self.one_hot, self.starts)
+            joint, cells = _joint_entropies(class_one_hot, self.one_hot32, self.starts)
             self._class_tables = {key: (self._entropy(class_one_hot, np.array([0]))[0], class_one_hot.shape[1],
                                         joint, cells)}
         return self._class_tables[key]
@@ -196,7 +204,7 @@ class DiscreteFeatures:
             bounds = np.append(self.starts, self.one_hot.shape[1])
             for feature in range(self.n_features):
                 block = self.one_hot[:, bounds[feature] : bounds[feature + 1]]
-                joint, cells = _joint_entropies(block, self.one_hot, self.starts)
+                joint, cells = _joint_entropies(block, self.one_hot32, self.starts)
                 mutual[feature] = marginals[feature] + marginals - self._miller_madow(joint, cells)
             totals = marginals[:, None] + marginals[None, :]
             self._feature_su = _symmetrical_uncertainty((mutual + mutual.T) / 2.0, totals)
@@ -210,13 +218,28 @@ class DiscreteFeatures:
             marginals = self._miller_madow(self.entropies, self.levels)
             start = self.starts[feature]
             block = self.one_hot[:, start : start + self.levels[feature]]
-            joint, cells = _joint_entropies(block, self.one_hot, self.starts)
+            joint, cells = _joint_entropies(block, self.one_hot32, self.starts)
             mutual = marginals[feature] + marginals - self._miller_madow(joint, cells)
             row = _symmetrical_uncertainty(mutual, marginals[feature] + marginals)
             row[feature] = 1.0 if marginals[feature] > 0 else 0.0
             self._su_rows[feature] = row
         return self._su_rows[feature]
 
+
+    def partition_signatures(self) -> list[bytes]:
+        """Per feature, its partition of the samples as bytes (bins renamed in order of first appearance).
+
+        Computed once for every feature (ES asks for it once per concept): equal signatures are exact copies.
+        """
+        if self._signatures is None:
+            codes = self.codes
+            values = np.arange(int(codes.max(initial=0)) + 1)[:, None, None]
+            is_value = codes[None, :, :] == values  # (value, sample, feature)
+            first_seen = np.where(is_value.any(axis=1), is_value.argmax(axis=1), codes.shape[0])
+            rank_of_value = np.argsort(np.argsort(first_seen, axis=0, kind="stable"), axis=0, kind="stable")
+            canonical = np.take_along_axis(rank_of_value, codes, axis=0).T.astype(np.int16)  # bins renamed
+            self._signatures = [partition.tobytes() for partition in canonical]
+        return self._signatures
 
 class LazyCorrelations:
     """Feature-feature SU rows on demand: what ES reads of the matrix (rows of chosen features)."""
@@ -233,16 +256,11 @@ class LazyCorrelations:
         Two features are exact copies (SU = 1) exactly when their bins partition the samples the same
         way; comparing partitions (bins renamed in order of first appearance) finds them without SU rows.
         """
-        codes = self.table.codes[:, features]
-        values = np.arange(int(codes.max(initial=0)) + 1)[:, None, None]
-        is_value = codes[None, :, :] == values  # (value, sample, feature)
-        first_seen = np.where(is_value.any(axis=1), is_value.argmax(axis=1), codes.shape[0])
-        rank_of_value = np.argsort(np.argsort(first_seen, axis=0, kind="stable"), axis=0, kind="stable")
-        canonical = np.take_along_axis(rank_of_value, codes, axis=0).T.astype(np.int16)  # bins renamed
+        signatures = self.table.partition_signatures()
         seen: set[bytes] = set()
         keep = np.zeros(len(features), dtype=bool)
-        for column, partition in enumerate(canonical):
-            signature = partition.tobytes()
+        for column, feature in enumerate(features):
+            signature = signatures[int(feature)]
             keep[column] = signature not in seen
             seen.add(signature)
         return keep

@@ -137,8 +137,18 @@ def one_site_probabilities(posterior: ScenePosterior, max_steps: int = 50, toler
     if posterior.cross is not None:
         assert posterior.mode is not None and posterior.W is not None, "cross, mode and W are set together"
         cross, mode, W = posterior.cross, posterior.mode[:, None, None, :], posterior.W[:, None, None, :]
-        moved = mode + cross.transpose(0, 2, 1)[:, None, :, :] * shift[..., None]  # [g, t, j, n]
-        residual = sigmoid(mode) - sigmoid(moved) + W * (moved - mode)
+        # residual = sigmoid(mode) - sigmoid(moved) + W (moved - mode), moved = mode + Cov(train, j) shift,
+        # on [g, t, j, n] arrays (the largest of the decision) computed in place, the same operations in order
+        moved = cross.transpose(0, 2, 1)[:, None, :, :] * shift[..., None]
+        moved += mode  # [g, t, j, n]
+        residual = np.multiply(moved, 0.5)
+        np.tanh(residual, out=residual)
+        residual += 1.0
+        residual *= 0.5  # sigmoid(moved), as gp.sigmoid
+        np.subtract(sigmoid(mode), residual, out=residual)
+        moved -= mode
+        moved *= W
+        residual += moved
         # Cov(scene, train) r for every (g, t, j), one matrix product per classifier
         along = np.matmul(residual.reshape(n_batch, 2 * m, -1), cross).reshape(n_batch, 2, m, m)
         at_site = np.diagonal(along, axis1=2, axis2=3)  # (g, t, j)
@@ -196,7 +206,6 @@ def fit_modes(kernels: np.ndarray, targets: np.ndarray, kernel_of_row: np.ndarra
     kernels32 = kernels.astype(np.float32)
     positive = (targets + 1.0) / 2.0
     f = np.zeros((n_rows, n)) if start is None else np.array(start, dtype=float)
-    identity = np.eye(n, dtype=np.float32)
     sw = np.empty((n_rows, n))
     factors = np.empty((n_rows, n, n), dtype=np.float32)
     factored_at = np.empty((n_rows, n))
@@ -214,7 +223,9 @@ def fit_modes(kernels: np.ndarray, targets: np.ndarray, kernel_of_row: np.ndarra
             pi = sigmoid(f[row])
             sw[row] = np.sqrt(pi * (1.0 - pi))
             weights = sw[row].astype(np.float32)
-            B = identity + weights[:, None] * kernels32[kernel_of_row[row]] * weights[None, :]
+            B = weights[:, None] * kernels32[kernel_of_row[row]]  # B = I + S K S, built in place (one n x n array)
+            B *= weights[None, :]
+            B.flat[:: n + 1] += 1.0
             # B is symmetric, so B.T is the same matrix in the Fortran order LAPACK wants (no copy);
             # the factor comes back in Fortran order and is stored transposed, again without a copy.
             factors[row] = spotrf(B.T, lower=1, clean=0, overwrite_a=1)[0].T
@@ -264,11 +275,12 @@ def predict_from_modes(cross_kernels: np.ndarray, variance: float, sw: np.ndarra
 
 
 def pivoted_cholesky(points: np.ndarray, length_scale: float, variance: float, tolerance: float,
-                     max_rank: int) -> np.ndarray | None:
+                     max_rank: int, truncate: bool = False) -> np.ndarray | None:
     """Phi (N, r) with K(points, points) ~ Phi Phi^T, every residual diagonal entry below ``tolerance``.
 
     Greedy pivoted Cholesky: each step takes the point with the largest residual variance. Returns None
-    if ``max_rank`` columns do not reach the tolerance (the kernel is not of low numerical rank).
+    if ``max_rank`` columns do not reach the tolerance (the kernel is not of low numerical rank), or with
+    ``truncate`` those ``max_rank`` columns (a rough approximation, e.g. to start Newton from).
     """
     n_points = len(points)
     if n_points == 0:
@@ -283,7 +295,7 @@ def pivoted_cholesky(points: np.ndarray, length_scale: float, variance: float, t
         if residual[pivot] < tolerance:
             return Phi_T[:k].T
         if k == width:
-            return None
+            return Phi_T.T if truncate else None
         column = np.exp(scale * (norms + norms[pivot] - 2.0 * (points @ points[pivot])))  # k(x, x_pivot) / variance
         column *= variance
         column -= Phi_T[:k, pivot] @ Phi_T[:k]

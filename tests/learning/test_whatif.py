@@ -117,6 +117,22 @@ def test_batched_newton_and_low_rank_fits_match_the_classifier():
     assert pivoted_cholesky(np.vstack([X, scene]), 1.4, 4.0, 1e-8, 5) is None  # rank 5 is not enough
 
 
+def test_the_dense_refits_warm_start_changes_only_the_path_not_the_mode(monkeypatch):
+    """Issue 28: from DENSE_WARM_FROM examples Newton starts at a rank-40 approximation's mode; same result."""
+    from learning.whatif import fast
+
+    assert pivoted_cholesky(np.random.default_rng(0).normal(size=(30, 3)), 1.0, 4.0, 1e-12, 4, truncate=True).shape \
+        == (30, 4)
+    task = SyntheticTask(n_features=12, n_informative=4, seed=5)
+    state = random_state(task, 60, 7, np.random.default_rng(1))
+    subsets = {c: np.arange(5 + k) for k, c in enumerate(state.concepts)}  # > 3 features: the dense path
+    monkeypatch.setattr(fast, "feature_query_subsets", lambda _state: subsets)
+    cold = fast.feature_outcomes(state)
+    monkeypatch.setattr(fast, "DENSE_WARM_FROM", 0)
+    warm = fast.feature_outcomes(state)
+    assert np.max(np.abs(warm - cold)) < 1e-5
+
+
 def test_the_feature_query_is_simulated_only_while_it_can_be_asked():
     state = small_state(0, answered=True)
     assert FeatureQuery() not in candidate_actions(state)
