@@ -31,6 +31,7 @@ sys.path.insert(0, str(ROOT))
 from dialog.experiments.doc_tables import (  # noqa: E402
     Plan,
     findings_table,
+    format_p,
     load_plan,
     report_findings,
     report_tables,
@@ -144,7 +145,7 @@ def summary_findings(plan: Plan, replications: dict, reports: dict) -> str:
                 cells = [c for c in finding["by_data_seed"].values() if c["tested"]]
                 pooled = finding["pooled"]
                 verdict = ("not tested: " + pooled["why"]) if not pooled["tested"] else \
-                    f"{'**holds**' if pooled['holds'] else 'does not hold'} ({_p(pooled['p_holm'])})"
+                    f"{'**holds**' if pooled['holds'] else 'does not hold'} ({format_p(pooled['p_holm'])})"
                 lines.append(f"| {run.suite} | {finding['id']}: {finding['text']} | "
                              f"{sum(c['direction'] for c in cells)} of {len(cells)} | {verdict} |")
         elif run.suite in reports:
@@ -193,10 +194,6 @@ def wall_times(manifest: dict) -> str:
                      f"{record['wall_seconds']:.0f} s |")
     lines.append(f"| all | `make experiments` | | {manifest.get('wall_seconds', 0):.0f} s |")
     return "\n".join(lines)
-
-
-def _p(p: float) -> str:
-    return f"{p:.3g}" if p >= 1e-4 else f"{p:.1e}"
 
 
 def render(plan: Plan, manifest: dict, out: Path) -> list[str]:

@@ -21,6 +21,8 @@ from pathlib import Path
 
 import tomllib
 
+from dialog.experiments.report import _fmt_p as format_p
+from dialog.experiments.report import numbers_in_words
 from learning.errors import SettingsError
 
 BEGIN = re.compile(r"<!-- experiments:begin (?P<name>[\w.:-]+) -->")
@@ -164,8 +166,8 @@ def results_table(replication: dict) -> str:
     lines = ["Conditions: " + "; ".join(_condition_line(c, next((r["at"] for r in c["strategies"]), None), axis)
                                          for c in conditions) + ".", "",
              f"Held-out accuracy, mean ± standard error over {_episodes_per_cell(conditions)} episodes a cell "
-             f"(data seeds {_words(replication['data_seeds'])} x {replication['datasets']} training pools x "
-             f"seeds {_words(replication['seeds'])}):", "",
+             f"(data seeds {numbers_in_words(replication['data_seeds'])}, {replication['datasets']} training pools "
+             f"each, episode seeds {numbers_in_words(replication['seeds'])}):", "",
              "| strategy | " + " | ".join(c["name"] for c in conditions) + " |", "|---" * (len(conditions) + 1) + "|"]
     for strategy in strategies:
         cells = [f"{r['pooled']['mean']:.3f} ± {r['pooled']['error']:.3f}" if (r := cell.get((c["name"], strategy)))
@@ -185,21 +187,10 @@ def _episodes_per_cell(conditions: list[dict]) -> str:
     return "/".join(map(str, counts))
 
 
-def _words(numbers) -> str:
-    values = [int(n) for n in numbers]
-    if len(values) > 2 and values == list(range(values[0], values[0] + len(values))):
-        return f"{values[0]}-{values[-1]}"
-    return ", ".join(map(str, values))
-
-
-def _p(p: float) -> str:
-    return f"{p:.3g}" if p >= 1e-4 else f"{p:.1e}"
-
-
 def _seed_cell(cell: dict | None) -> str:
     if not cell or not cell["tested"]:
         return "–"
-    return f"{'+' if cell['direction'] else '−'} {_p(cell['p'])}"
+    return f"{'+' if cell['direction'] else '−'} {format_p(cell['p'])}"
 
 
 def finding_verdict(cell: dict) -> str:
@@ -226,7 +217,7 @@ def findings_table(replication: dict) -> str:
             effects = "; ".join(f"vs {c['than']} {c['mean'] - c['mean_than']:+.3f} [{c['ci'][0]:+.3f}, "
                                 f"{c['ci'][1]:+.3f}], r {c['effect_r']:+.2f}" if c["ci"] and c["effect_r"] is not None
                                 else f"vs {c['than']} {c['mean'] - c['mean_than']:+.3f}" for c in pooled["comparisons"])
-            tail = f"{pooled['pairs']} | {effects} | {_p(pooled['p_holm'])} | {finding_verdict(pooled)}"
+            tail = f"{pooled['pairs']} | {effects} | {format_p(pooled['p_holm'])} | {finding_verdict(pooled)}"
         else:
             tail = f"– | {pooled['why']} | – | not tested"
         lines.append(f"| {finding['id']}: {finding['text']} | "
