@@ -117,5 +117,5 @@ def file_label(name: str) -> str:
     return str(name)
 
 
-__all__ = ["ACCEPTED", "STRATEGIES", "STRATEGY_NAMES", "DecisionTheoreticStrategy", "Strategy", "check_strategy_name",
-           "file_label", "is_external", "make_strategy"]
+__all__ = ["ACCEPTED", "PLUGIN_FORM", "RL_PREFIX", "STRATEGIES", "STRATEGY_NAMES", "DecisionTheoreticStrategy",
+           "Strategy", "check_strategy_name", "file_label", "is_external", "is_plugin_spec", "make_strategy"]

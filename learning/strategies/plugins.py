@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import importlib
 import inspect
+from typing import Any
 
 from learning.errors import SettingsError
 from learning.strategies.rl_questioner import PREFIX as RL_PREFIX
@@ -39,7 +40,7 @@ def split_spec(spec: str) -> tuple[str, str]:
     return module, cls
 
 
-def load_plugin(spec: str, **options):
+def load_plugin(spec: str, **options) -> Any:
     """An instance of the class ``spec`` names (the user's code runs here); SettingsError says what went wrong."""
     module_name, cls_name = split_spec(spec)
     try:
@@ -54,7 +55,7 @@ def load_plugin(spec: str, **options):
         raise SettingsError(f"strategy '{spec}': '{cls_name}' is not a strategy class (a subclass of "
                             f"learning.Strategy, or a class with a choose(state, rng) method)")
     try:
-        strategy = cls(**options)
+        strategy: Any = cls(**options)
     except Exception as error:  # a constructor that fails is the user's error, shown in one line
         raise SettingsError(f"strategy '{spec}': {cls_name}({', '.join(f'{k}=...' for k in sorted(options))}) "
                             f"failed ({type(error).__name__}: {error}); it must build with no arguments") from None
