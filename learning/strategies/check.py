@@ -50,7 +50,7 @@ class StrategyCheckReport:
 
     def __str__(self) -> str:
         return (f"{self.name}: passed {len(self.rules)} checks on {self.states} synthetic states (seeds "
-                f"{', '.join(map(str, self.seeds))}): {'; '.join(self.rules)}")
+                f"{', '.join(map(str, self.seeds))})")
 
 
 def synthetic_states(seed: int, feature_selection: str | None = None) -> list[tuple[str, LearningState]]:
