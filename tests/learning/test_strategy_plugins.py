@@ -140,3 +140,21 @@ def test_a_study_file_takes_a_plugin_and_refuses_a_broken_one(mypkg, tmp_path):
     with pytest.raises(DataFileError, match="study.toml \\[\\[conditions\\]\\] 2: strategy 'mypkg/mystrategy.py:"
                                             "MyStrategy': a strategy is loaded from an importable module, not a file"):
         load_study(path)
+
+
+@pytest.mark.e2e
+def test_a_teach_session_records_a_plugin_and_its_resume_checks_it_still_loads(tmp_path, capsys):
+    spec = "learning.strategies.examples:EveryOtherTurn"
+    path = tmp_path / "session.jsonl"
+    assert main(["teach", "--teacher", "scripted", "--strategy", spec, "--turns", "2", "--budget", "5",
+                 "--transcript", str(path), "--no-pictures"]) == 0
+    lines = [json.loads(line) for line in path.read_text().splitlines()]
+    assert lines[0]["session"]["strategy"] == spec and [r["action"]["kind"] for r in lines[1:]] == ["label", "none"]
+    lines[0]["session"]["strategy"] = "learning.strategies.gone:EveryOtherTurn"
+    path.write_text("".join(json.dumps(line) + "\n" for line in lines))
+    capsys.readouterr()
+    assert main(["teach", "--resume", str(path), "--no-pictures"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith(f"teachbot teach: {path}: line 1: the session header's strategy can't be loaded now: "
+                          "strategy 'learning.strategies.gone:EveryOtherTurn': can't import module") and \
+        len(err.splitlines()) == 1
