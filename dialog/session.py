@@ -23,7 +23,7 @@ from dialog.user_weights import weights_from_header
 from learning.actions import DEFAULT_COSTS
 from learning.errors import DataFileError, SettingsError, TranscriptError
 from learning.rl.policy_file import policy_digest
-from learning.strategies import STRATEGY_NAMES
+from learning.strategies import PLUGIN_FORM, STRATEGY_NAMES, check_strategy_name, is_plugin_spec
 from learning.strategies.rl_questioner import PREFIX as RL_PREFIX
 
 TEACHERS = ("terminal", "scripted", "replay")  # the kinds a teach session records
@@ -83,8 +83,14 @@ def check_header(header: dict, path) -> None:
             raise refuse(name, f"one of {', '.join(available(folder))}")
     if isinstance(header["strategy"], str) and header["strategy"].startswith(RL_PREFIX):
         _check_policy(header, path, refuse)
+    elif is_plugin_spec(header["strategy"]):  # module.path:ClassName: it must still import and build
+        try:
+            check_strategy_name(header["strategy"])
+        except SettingsError as error:
+            raise TranscriptError(f"{path}: line 1: the session header's strategy can't be loaded now: {error}") \
+                from None
     elif header["strategy"] not in STRATEGY_NAMES:
-        raise refuse("strategy", f"one of {', '.join(STRATEGY_NAMES)}, or {RL_PREFIX}FILE")
+        raise refuse("strategy", f"one of {', '.join(STRATEGY_NAMES)}, {RL_PREFIX}FILE, or {PLUGIN_FORM}")
     if not (_is_int(header["seed"]) and header["seed"] >= 0):
         raise refuse("seed", "a whole number of 0 or more")
     for name in ("turns", "change_every"):

@@ -8,7 +8,9 @@ submodule such as ``learning.gp`` does not pull in scikit-learn:
 
 - ``ConceptClassifier``: a scikit-learn classifier of one binary GP per class;
 - ``TeachingLoop``: observe a scene, ``ask`` a ``Query``, ``tell`` the answer;
-- ``LearningState.apply`` (also ``apply_answer``): the one place an answer changes the learner.
+- ``LearningState.apply`` (also ``apply_answer``): the one place an answer changes the learner;
+- ``Strategy``, ``Decision`` and the actions (``LabelQuery``, ``DemoQuery``, ``FeatureQuery``, ``NoQuery``):
+  a strategy of your own, which ``check_strategy`` checks and ``module.path:ClassName`` runs.
 """
 
 from importlib import import_module
@@ -28,6 +30,15 @@ _EXPORTS = {
     "LearningState": "learning.state",
     "STRATEGY_NAMES": "learning.strategies",
     "make_strategy": "learning.strategies",
+    "Strategy": "learning.strategies.base",
+    "check_strategy": "learning.strategies.check",
+    "StrategyCheckError": "learning.strategies.check",
+    "Decision": "learning.actions",
+    "Action": "learning.actions",
+    "LabelQuery": "learning.actions",
+    "DemoQuery": "learning.actions",
+    "FeatureQuery": "learning.actions",
+    "NoQuery": "learning.actions",
     "TeachbotError": "learning.errors",
 }
 

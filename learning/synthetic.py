@@ -97,10 +97,12 @@ def run_episode(strategy, task: SyntheticTask, rng: np.random.Generator, budget:
 
 def random_state(task: SyntheticTask, n_train: int, n_objects: int, rng: np.random.Generator,
                  feature_query_answered: bool = False, budget: float = 1000.0, turns: int = 2000,
-                 change_every: int = 5) -> LearningState:
+                 change_every: int = 5, feature_selection: str | None = None) -> LearningState:
     """A learning state part-way through an episode: ``n_train`` examples with uneven classes, a scene of
-    ``n_objects``, some budget spent, a random recent history; the benchmark and the tests draw these."""
-    state = LearningState(task.concepts, task.feature_names, budget, turns, change_every=change_every)
+    ``n_objects``, some budget spent, a random recent history; the benchmark, the tests and ``check_strategy``
+    draw these (``feature_selection`` as the strategy's, see LearningState)."""
+    state = LearningState(task.concepts, task.feature_names, budget, turns, change_every=change_every,
+                          feature_selection=feature_selection)
     proportions = rng.dirichlet(np.full(len(task.concepts), 2.0))
     X, labels = task.sample(n_train, rng, proportions)
     scene_X, _ = task.sample(n_objects, rng)

@@ -10,8 +10,8 @@ from pathlib import Path
 
 from bullet_world.datafiles import available
 from dialog.settings import DEFAULTS, EpisodeSettings
-from learning.errors import did_you_mean
-from learning.strategies.rl_questioner import PREFIX as RL_PREFIX
+from learning.errors import SettingsError, did_you_mean
+from learning.strategies import PLUGIN_FORM, RL_PREFIX, check_strategy_name, is_plugin_spec
 
 
 class HelpFormatter(argparse.HelpFormatter):
@@ -229,15 +229,21 @@ def positive_seconds(text: str) -> float:
 
 
 def strategy_choice(strategies):
-    """An argparse type: one of ``strategies``, or ``rl:FILE`` (the file made absolute, so a resume finds it)."""
+    """An argparse type: one of ``strategies``, ``rl:FILE`` (the file made absolute, so a resume finds it) or
+    ``module.path:ClassName`` (imported now, so a bad one is one message before anything runs)."""
     def parse(text: str) -> str:
         if text.startswith(RL_PREFIX) and len(text) > len(RL_PREFIX):
             return RL_PREFIX + str(Path(text[len(RL_PREFIX):]).resolve())
+        if is_plugin_spec(text):
+            try:
+                return check_strategy_name(text)
+            except SettingsError as error:
+                raise argparse.ArgumentTypeError(str(error)) from None
         if text in strategies:
             return text
         raise argparse.ArgumentTypeError(f"'{text}'{did_you_mean(text, strategies)} is not one of the accepted names: "
-                                         f"{', '.join(strategies)}, or "
-                                         "rl:FILE (a trained questioner policy .toml)")
+                                         f"{', '.join(strategies)}, "
+                                         f"rl:FILE (a trained questioner policy .toml), or {PLUGIN_FORM}")
     return parse
 
 
@@ -253,8 +259,9 @@ def add_episode_options(parser: argparse.ArgumentParser, strategies, default_str
     parser.add_argument("--change-every", type=positive_int, default=defaults.change_every,
                         help=f"a new scene every r turns (default {defaults.change_every})")
     parser.add_argument("--strategy", default=default_strategy, type=strategy_choice(strategies), metavar="STRATEGY",
-                        help=f"questioning strategy: {', '.join(strategies)}, or rl:FILE (a questioner policy from "
-                             f"teachbot train-questioner) (default {default_strategy})")
+                        help=f"questioning strategy: {', '.join(strategies)}, rl:FILE (a questioner policy from "
+                             f"teachbot train-questioner), or {PLUGIN_FORM}: runs your code "
+                             f"(default {default_strategy})")
     add_task_option(parser, defaults.task)
     add_kitchen_option(parser, defaults.kitchen)
 

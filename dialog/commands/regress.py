@@ -38,7 +38,8 @@ def register(commands) -> None:
     parser.add_argument("--results", type=Path, default=None, help="results folder (default results/<suite>)")
     parser.add_argument("--strategies", nargs="+", default=None,
                         help="run only these strategies; rl:FILE adds a trained questioner policy "
-                             "(teachbot train-questioner)")
+                             "(teachbot train-questioner), module.path:ClassName your own Strategy class from an "
+                             "importable module (this runs your code)")
     parser.add_argument("--seeds", nargs="+", type=seeds, default=None, help="override the suite's seeds")
     parser.add_argument("--budget", type=budget, default=None, help="override every condition's budget")
     parser.add_argument("--datasets", type=positive_int, default=None, help="override the number of data sets")

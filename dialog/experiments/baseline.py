@@ -13,7 +13,7 @@ from dialog.experiments.suite import SUITE_DIR, Suite, SuiteError
 from dialog.output_paths import keep_superseded
 from learning.datafiles import inside
 from learning.errors import SettingsError
-from learning.strategies.rl_questioner import PREFIX as RL_PREFIX
+from learning.strategies import is_external
 
 BASELINE_DIR = SUITE_DIR / "baselines"
 DEFAULT_TOLERANCE = 0.05
@@ -149,8 +149,8 @@ def check_against_baseline(suite: Suite, summaries: list[CheckpointSummary],
     axis = suite.axis  # questions, turns or demonstrations
     for s in summaries:
         stored = bands.get(s.condition, {}).get(s.strategy)
-        if stored is None and (s.strategy in suite.weights or s.strategy.startswith(RL_PREFIX)):
-            continue  # a --weights strategy or a trained policy: the user's own, no baseline to hold it to
+        if stored is None and (s.strategy in suite.weights or is_external(s.strategy)):
+            continue  # a --weights strategy, a trained policy or a user's class: no baseline to hold it to
         if stored is None:
             failures.append(f"{s.strategy}/{s.condition}: not in the baseline")
             continue

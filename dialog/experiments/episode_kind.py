@@ -14,8 +14,8 @@ from dialog.experiments.pools import load_pools
 from dialog.experiments.report import markdown_report, write_episode_csvs
 from dialog.experiments.runner import RenderBar, episode_specs, run_locally, run_on_ray
 from dialog.experiments.suite import Suite, SuiteError
-from learning.strategies import STRATEGY_NAMES, make_strategy
-from learning.strategies.rl_questioner import PREFIX as RL_PREFIX
+from learning.errors import SettingsError
+from learning.strategies import STRATEGY_NAMES, check_strategy_name
 
 
 @register_kind
@@ -24,15 +24,13 @@ class EpisodesKind(SuiteKind):
 
     def load(self, suite: Suite) -> Suite:
         where = suite.path or suite.name
-        policies = [s for s in suite.strategies if s.startswith(RL_PREFIX)]
         known = strategy_names_with_variants(STRATEGY_NAMES)  # NAME+turns: DT blind to embodied costs
-        unknown = [s for s in suite.strategies if s not in known and s not in suite.weights
-                   and s not in policies]
-        if unknown:
-            raise SuiteError(f"{where}: unknown strategies {unknown}; choose from: {', '.join(STRATEGY_NAMES)}, "
-                             f"or {RL_PREFIX}FILE (a trained questioner policy)")
-        for name in policies:  # a missing or bad policy file is one message now, not in every worker
-            make_strategy(name)
+        for name in suite.strategies:  # a bad policy file or user class is one message now, not in every worker
+            if name not in suite.weights:
+                try:
+                    check_strategy_name(name, known)
+                except SettingsError as error:
+                    raise SuiteError(f"{where}: {error}") from None
         for finding in suite.findings:
             if finding.at not in suite.checkpoints:
                 raise SuiteError(f"{where}: finding '{finding.id}' compares at {finding.at}, which is not one of "

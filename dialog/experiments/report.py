@@ -12,6 +12,7 @@ from dialog.experiments.analysis import CheckpointSummary, FindingResult, group_
 from dialog.experiments.episodes import SERIES
 from dialog.experiments.suite import Suite
 from learning.significance import PairedComparison
+from learning.strategies import file_label
 
 
 def write_episode_csvs(results: list[dict], out: Path) -> Path:
@@ -24,8 +25,8 @@ def write_episode_csvs(results: list[dict], out: Path) -> Path:
                           "feature", "spent", "seconds", "csv"])
         for result in results:
             spec, series = result["spec"], result["series"]
-            path = out / "episodes" / spec["condition"]["name"] / f"{spec['strategy']}-d{spec['dataset']}" \
-                f"-s{spec['seed']}.csv"
+            path = out / "episodes" / spec["condition"]["name"] / f"{file_label(spec['strategy'])}" \
+                f"-d{spec['dataset']}-s{spec['seed']}.csv"  # as the transcript is named: no ':' or '/' in it
             path.parent.mkdir(parents=True, exist_ok=True)
             with open(path, "w", newline="") as handle:
                 writer = csv.writer(handle)

@@ -15,14 +15,7 @@ from dialog.experiments.episodes import EpisodeSpec, run_episode
 from dialog.experiments.suite import Suite
 from learning.actions import DEFAULT_COSTS
 from learning.errors import SetupError
-from learning.strategies.rl_questioner import PREFIX as RL_PREFIX
-
-
-def file_label(strategy: str) -> str:
-    """A strategy's name as a file name: ``rl:path/to/questioner.toml`` becomes ``rl-questioner``."""
-    if strategy.startswith(RL_PREFIX):
-        return f"rl-{Path(strategy[len(RL_PREFIX):]).stem}"
-    return strategy
+from learning.strategies import file_label
 
 
 def episode_specs(suite: Suite, results_dir: Path) -> list[EpisodeSpec]:

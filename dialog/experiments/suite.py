@@ -182,11 +182,13 @@ def _suite(table: dict, where: str, known_strategies) -> Suite:
     strategies = texts(table, "strategies", where, nonempty=True)
     if known_strategies is not None and kind == "episodes":
         from dialog.embodied import strategy_names_with_variants  # NAME+turns: DT ignoring embodied costs
+        from learning.strategies import PLUGIN_FORM, RL_PREFIX, is_external  # rl:FILE, module:Class: kind.load
 
         known_strategies = strategy_names_with_variants(known_strategies)
-        unknown = [s for s in strategies if s not in known_strategies]
+        unknown = [s for s in strategies if s not in known_strategies and not is_external(s)]
         if unknown:
-            raise SuiteError(f"{where}: unknown strategies {unknown}; known: {', '.join(known_strategies)}")
+            raise SuiteError(f"{where}: unknown strategies {unknown}; known: {', '.join(known_strategies)}, "
+                             f"{RL_PREFIX}FILE (a trained questioner policy) or {PLUGIN_FORM}")
     scene_size = integer(table, "objects_per_scene", where, None, low=1)
     conditions = tuple(_condition(c, f"{where} condition {i + 1}", scene_size)
                        for i, c in enumerate(tables(table, "condition", where, [])))

@@ -17,9 +17,9 @@ from dialog.settings import DEFAULTS
 from dialog.teachers import SCRIPTED_OPTIONS
 from learning import datafiles as df
 from learning.actions import DEFAULT_COSTS
-from learning.errors import DataFileError
+from learning.errors import DataFileError, SettingsError
 from learning.limits import maximum
-from learning.strategies import STRATEGY_NAMES
+from learning.strategies import PLUGIN_FORM, STRATEGY_NAMES, check_strategy_name, is_plugin_spec
 
 ORDERINGS = ("latin", "given")
 ITEM_KINDS = ("likert", "text")
@@ -135,7 +135,7 @@ def _condition(table: dict, where: str) -> Condition:
         instructions=df.text(table, "instructions", where, default="Teach the robot the words of the task."),
         task=df.text(table, "task", where, default=DEFAULTS.task, choices=available("tasks")),
         kitchen=df.text(table, "kitchen", where, default=DEFAULTS.kitchen, choices=available("kitchens")),
-        strategy=df.text(table, "strategy", where, choices=STRATEGY_NAMES),
+        strategy=_strategy(table, where),
         budget=df.number(table, "budget", where, default=DEFAULTS.budget, low=0, high=maximum("budget")),
         turns=df.integer(table, "turns", where, default=DEFAULTS.turns, low=1, high=500),
         change_every=df.integer(table, "change_every", where, default=DEFAULTS.change_every, low=1),
@@ -144,6 +144,21 @@ def _condition(table: dict, where: str) -> Condition:
         viewer=df.flag(table, "viewer", where, default=False),
         fetch_from_pantry=df.flag(table, "fetch_from_pantry", where, default=True),
     )
+
+
+def _strategy(table: dict, where: str) -> str:
+    """A condition's strategy: a registered name, or ``module.path:ClassName`` (imported now: it runs the user's
+    code, so a bad one is refused before the first participant)."""
+    value = df.text(table, "strategy", where)
+    if not is_plugin_spec(value):
+        if value not in STRATEGY_NAMES:
+            raise DataFileError(f"{where}: strategy '{value}' is not one of {', '.join(STRATEGY_NAMES)}, or "
+                                f"{PLUGIN_FORM}")
+        return value
+    try:
+        return check_strategy_name(value)
+    except SettingsError as error:
+        raise DataFileError(f"{where}: {error}") from None
 
 
 def _participants(data: dict, where: str) -> tuple[str, ...]:

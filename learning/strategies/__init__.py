@@ -17,13 +17,18 @@ dt-task    DT on ACD, CDU, IV and PM (thesis ch. 7)
 dt-task-env DT on all seven decision features (thesis ch. 7; IRL weights)
 scripted-expert the scripted expert of thesis §7.4.1 (rules in data/scripted-expert.toml)
 rl:FILE    a trained questioner policy (teachbot train-questioner; beyond the thesis)
+pkg.mod:Cls your own strategy class, imported from an importable module (runs your code; plugins.py)
 ========== ==================================================================
+
+``check_strategy_name(name)`` is the one check of a name that callers (suites, study files, the
+command line, a resumed session) use before anything runs.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
 from functools import partial
+from pathlib import Path
 
 from learning.errors import SettingsError, did_you_mean
 from learning.strategies.active import ActiveFeatureSelectingStrategy, ActiveStrategy
@@ -32,6 +37,8 @@ from learning.strategies.base import Strategy
 from learning.strategies.decision_theoretic import DecisionTheoreticStrategy
 from learning.strategies.hfs import HfsActiveStrategy, HfsPassiveStrategy
 from learning.strategies.passive import PassiveFeatureSelectingStrategy, PassiveStrategy
+from learning.strategies.plugins import FORM as PLUGIN_FORM
+from learning.strategies.plugins import is_plugin_spec, load_plugin, plugin_file_label
 from learning.strategies.random_choice import RandomStrategy
 from learning.strategies.rl_questioner import PREFIX as RL_PREFIX
 from learning.strategies.rl_questioner import RLQuestionerStrategy
@@ -55,18 +62,25 @@ STRATEGIES: dict[str, Callable[..., Strategy]] = {
 STRATEGY_NAMES = tuple(STRATEGIES)
 
 
+ACCEPTED = (f"{', '.join(STRATEGY_NAMES)}, {RL_PREFIX}FILE (a trained questioner policy .toml), or "
+            f"{PLUGIN_FORM}")
+
+
 def make_strategy(name: str, **options) -> Strategy:
     """The strategy called ``name``; a clear error lists the accepted names.
 
+    ``name`` is a registered name, ``rl:FILE`` or ``module.path:ClassName`` (imports and runs the user's code).
     Options go to the strategy's constructor, e.g. ``make_strategy("dt", weights={...}, engine="reference")``
     or ``make_strategy("all-cd", examples_per_concept=3)``.
     """
     if str(name).startswith(RL_PREFIX):  # a policy file: its path keeps its case
         return RLQuestionerStrategy(str(name)[len(RL_PREFIX):], name=str(name), **options)
+    if is_plugin_spec(name):  # module.path:ClassName keeps its case too
+        return load_plugin(str(name), **options)
     key = str(name).strip().lower()
     if key not in STRATEGIES:
         raise SettingsError(f"unknown strategy '{name}'{did_you_mean(key, STRATEGY_NAMES)}; choose one of: "
-                            f"{', '.join(STRATEGY_NAMES)}, or {RL_PREFIX}FILE (a trained questioner policy .toml)")
+                            f"{ACCEPTED}")
     if key == "dt" and "weights" in options:
         return DecisionTheoreticStrategy(name="dt", **options)
     try:
@@ -75,4 +89,33 @@ def make_strategy(name: str, **options) -> Strategy:
         raise SettingsError(f"strategy '{key}' does not take the options {sorted(options)} ({error})") from None
 
 
-__all__ = ["STRATEGIES", "STRATEGY_NAMES", "DecisionTheoreticStrategy", "Strategy", "make_strategy"]
+def is_external(name) -> bool:
+    """True for a strategy outside the registry: ``rl:FILE`` or ``module.path:ClassName`` (the user's own; no
+    stored baseline holds it)."""
+    return str(name).startswith(RL_PREFIX) or is_plugin_spec(name)
+
+
+def check_strategy_name(name: str, known=STRATEGY_NAMES) -> str:
+    """``name`` if it names a strategy: one of ``known``, or an external one that builds (a policy file that
+    loads, a class that imports and constructs); else one SettingsError listing what is accepted."""
+    if is_external(name):
+        make_strategy(name)
+        return str(name)
+    if name in known:
+        return name
+    accepted = ACCEPTED.replace(", ".join(STRATEGY_NAMES), ", ".join(known), 1)
+    raise SettingsError(f"unknown strategy '{name}'{did_you_mean(name, known)}; choose one of: {accepted}")
+
+
+def file_label(name: str) -> str:
+    """A strategy's name as a file name: ``rl:path/to/questioner.toml`` is ``rl-questioner``, ``pkg.mod:Class``
+    is ``pkg.mod.Class``, a registered name is itself."""
+    if str(name).startswith(RL_PREFIX):
+        return f"rl-{Path(str(name)[len(RL_PREFIX):]).stem}"
+    if is_plugin_spec(name):
+        return plugin_file_label(name)
+    return str(name)
+
+
+__all__ = ["ACCEPTED", "PLUGIN_FORM", "RL_PREFIX", "STRATEGIES", "STRATEGY_NAMES", "DecisionTheoreticStrategy",
+           "Strategy", "check_strategy_name", "file_label", "is_external", "is_plugin_spec", "make_strategy"]

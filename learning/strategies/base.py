@@ -11,7 +11,12 @@ from learning.state import LearningState
 
 
 class Strategy(ABC):
-    """Looks at the learning state and returns one action with a reason."""
+    """Looks at the learning state and returns one action with a reason.
+
+    The contract (``learning.check_strategy`` checks it): ``choose`` returns a :class:`Decision` with a one-sentence
+    explanation, asks only what the state admits and the budget covers (else ``NoQuery``), only reads the state,
+    and draws random numbers only from ``rng``. A subclass of your own runs as ``--strategy module.path:ClassName``.
+    """
 
     name: str = ""
     # None: the learner's models use every feature (or the teacher's answer); "FI", "ES" or "ER": where the teacher

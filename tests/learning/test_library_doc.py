@@ -11,3 +11,12 @@ def test_the_library_page_examples_run_as_written():
     result = doctest.testfile(str(DOC), module_relative=False, optionflags=flags, verbose=False)
     assert result.attempted > 20
     assert result.failed == 0, f"{result.failed} of {result.attempted} examples in {DOC.name} failed (see the output)"
+
+
+def test_the_worked_strategy_example_is_the_shipped_module():
+    """The page shows learning/strategies/examples.py's code (after its docstring) as it is."""
+    import re
+
+    shown = re.search(r"```python\n(import numpy as np\n.*?)```", DOC.read_text(), re.S)
+    source = (DOC.parents[1] / "learning" / "strategies" / "examples.py").read_text()
+    assert shown and shown.group(1) in source and source.endswith(shown.group(1))
