@@ -89,7 +89,8 @@ def test_a_missing_policy_is_one_line(tmp_path, capsys):
     assert err.count("\n") == 0 and "no questioner policy file there" in err
     with pytest.raises(SystemExit) as exited:  # argparse's own exit, in the tool's voice
         main(["demo", "--strategy", "nonsense"])
-    assert exited.value.code == 2 and "or rl:FILE" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert exited.value.code == 2 and "rl:FILE (a trained questioner policy .toml)" in err and err.count("\n") == 1
 
 
 def test_a_bad_out_path_is_one_line_before_any_training(tmp_path, capsys):
