@@ -30,6 +30,7 @@ sys.path.insert(0, str(ROOT))
 
 from dialog.experiments.doc_tables import (  # noqa: E402
     Plan,
+    finding_verdict,
     findings_table,
     format_p,
     load_plan,
@@ -38,11 +39,12 @@ from dialog.experiments.doc_tables import (  # noqa: E402
     results_table,
     splice,
     stamp,
+    verdict_words,
 )
+from dialog.experiments.suite import load_suite  # noqa: E402
 from learning.errors import SettingsError  # noqa: E402
 
 CODE = ("learning", "dialog", "bullet_world", "robot", "pyproject.toml")
-EPISODE_SUITES_REFUSING_DATA_SEEDS = ("ch5", "recipes")  # other kinds: one run on their own data
 
 
 def git(*words: str) -> str:
@@ -52,7 +54,7 @@ def git(*words: str) -> str:
 def command_for(run, plan: Plan, results: Path) -> list[str]:
     shown = os.path.relpath(results, ROOT) if results.resolve().is_relative_to(ROOT) else str(results)
     words = ["teachbot", "regress", "--suite", run.suite, "--results", shown, "--no-progress", "--json"]
-    if run.suite not in EPISODE_SUITES_REFUSING_DATA_SEEDS:
+    if load_suite(run.suite).kind == "episodes":  # other kinds (ch5, recipes): one run on their own data
         words += ["--data-seeds", *map(str, plan.data_seeds), "--seeds", *map(str, plan.seeds)]
     if run.strategies:
         words += ["--strategies", *run.strategies]
@@ -68,31 +70,30 @@ def run_all(plan: Plan, only: list[str] | None, out: Path, allow_dirty: bool) ->
     manifest = json.loads(manifest_path.read_text()) if manifest_path.exists() and only else {"runs": {}}
     manifest.update({"commit": git("rev-parse", "HEAD"), "dirty": dirty, "cores": os.cpu_count(),
                      "date": datetime.date.today().isoformat()})
-    started = time.perf_counter()
     for run in plan.runs:
         if only and run.suite not in only:
             continue
         results = out / run.suite
         if results.exists():
             shutil.rmtree(results)
-        words = command_for(run, plan, results)
+        words = command_for(run, plan, results)  # as the stamps show it (the results folder relative to ROOT)
+        argv = words[1:]
+        argv[argv.index("--results") + 1] = str(results)  # run with the full path
         print(f"$ {shlex.join(words)}", flush=True)
         began = time.perf_counter()
-        words[words.index("--results") + 1] = str(results)  # run with the full path, show the short one
-        done = subprocess.run([sys.executable, "-m", "dialog.cli", *words[1:]], cwd=ROOT, text=True,
+        done = subprocess.run([sys.executable, "-m", "dialog.cli", *argv], cwd=ROOT, text=True,
                               stdout=subprocess.PIPE)
         seconds = time.perf_counter() - began
         print(done.stdout[-2000:], flush=True)
         if done.returncode != 0:
             raise SystemExit(f"experiments: '{shlex.join(words)}' failed with exit code {done.returncode}")
         summary = json.loads(done.stdout.strip().splitlines()[-1])
-        manifest["runs"][run.suite] = {"command": shlex.join(command_for(run, plan, results)),
+        manifest["runs"][run.suite] = {"command": shlex.join(words),
                                        "wall_seconds": round(seconds, 1),
                                        "episodes": summary.get("episodes"), "commit": manifest["commit"],
                                        "dirty": dirty}
         print(f"  {run.suite}: {seconds:.0f} s", flush=True)
-    manifest["wall_seconds"] = round(time.perf_counter() - started, 1) + (
-        sum(r["wall_seconds"] for s, r in manifest["runs"].items() if only and s not in only))
+    manifest["wall_seconds"] = round(sum(r["wall_seconds"] for r in manifest["runs"].values()), 1)
     out.mkdir(parents=True, exist_ok=True)
     manifest_path.write_text(json.dumps(manifest, indent=1) + "\n")
     return manifest
@@ -107,7 +108,7 @@ def tables_from(plan: Plan, manifest: dict, out: Path) -> dict[str, str]:
             continue
         line = stamp({**manifest, "commit": record["commit"], "dirty": record["dirty"]}, record["command"])
         folder = out / run.suite
-        figures = _copy_figures(run, folder)
+        figures = _copy_figures(run, folder, plan.data_seeds[0])
         if (folder / "replication.json").exists():
             replications[run.suite] = json.loads((folder / "replication.json").read_text())
             tables[f"{run.suite}:results"] = results_table(replications[run.suite]) + figures + "\n\n" + line
@@ -123,10 +124,12 @@ def tables_from(plan: Plan, manifest: dict, out: Path) -> dict[str, str]:
     return tables
 
 
-def _copy_figures(run, folder: Path) -> str:
+def _copy_figures(run, folder: Path, data_seed: int) -> str:
+    """The run's figures into docs/img/experiments (an episodes suite's from its first data seed's report)."""
     lines = []
     for name, target, caption in run.figures:
-        source = next(iter(sorted(folder.glob(f"data-seed-*/{name}"))), folder / name)
+        source = folder / f"data-seed-{data_seed}" / name
+        source = source if source.exists() else folder / name
         if source.exists():
             destination = ROOT / "docs" / "img" / "experiments" / target
             destination.parent.mkdir(parents=True, exist_ok=True)
@@ -144,14 +147,14 @@ def summary_findings(plan: Plan, replications: dict, reports: dict) -> str:
             for finding in rep["findings"]:
                 cells = [c for c in finding["by_data_seed"].values() if c["tested"]]
                 pooled = finding["pooled"]
-                verdict = ("not tested: " + pooled["why"]) if not pooled["tested"] else \
-                    f"{'**holds**' if pooled['holds'] else 'does not hold'} ({format_p(pooled['p_holm'])})"
+                verdict = finding_verdict(pooled) + (f" ({format_p(pooled['p_holm'])})" if pooled["tested"]
+                                                     else f": {pooled['why']}")
                 lines.append(f"| {run.suite} | {finding['id']}: {finding['text']} | "
                              f"{sum(c['direction'] for c in cells)} of {len(cells)} | {verdict} |")
         elif run.suite in reports:
             for finding in report_findings(reports[run.suite]):
                 lines.append(f"| {run.suite} | {finding['id']}: {finding['text']} | (one data set) | "
-                             f"{'**holds**' if finding['holds'] else 'does not hold'} |")
+                             f"{verdict_words(finding['holds'])} |")
     return "\n".join(lines)
 
 

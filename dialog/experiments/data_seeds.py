@@ -31,11 +31,15 @@ def pooled_findings(suite: Suite, runs: dict[int, SuiteRun]) -> list[FindingResu
     return evaluate_findings(summarise(results, suite), suite)
 
 
+def _worst_holm_p(outcome: FindingResult) -> float:
+    """The largest Holm-corrected p of a finding's comparisons (the uncorrected p where none was corrected)."""
+    return max((c.p if c.p_holm is None else c.p_holm) for c in outcome.comparisons)
+
+
 def _verdict(outcome: FindingResult) -> str:
     if outcome.skipped:
         return "not tested"
-    worst = max((c.p if c.p_holm is None else c.p_holm) for c in outcome.comparisons)
-    return f"{'holds' if outcome.holds else 'does not hold'} (Holm p ≤ {_fmt_p(worst)})"
+    return f"{'holds' if outcome.holds else 'does not hold'} (Holm p ≤ {_fmt_p(_worst_holm_p(outcome))})"
 
 
 def _pooled_cells(outcome: FindingResult) -> str:
@@ -86,7 +90,7 @@ def _finding_cell(outcome: FindingResult) -> dict:
         return {"tested": False, "why": outcome.skipped}
     return {"tested": True, "holds": outcome.holds, "direction": _direction(outcome),
             "p": max(c.p for c in outcome.comparisons),
-            "p_holm": max((c.p if c.p_holm is None else c.p_holm) for c in outcome.comparisons),
+            "p_holm": _worst_holm_p(outcome),
             "pairs": min(getattr(c, "n", 0) for c in outcome.comparisons),
             "comparisons": [{"than": c.b, "mean": c.mean_a, "mean_than": c.mean_b,
                              "effect_r": getattr(c, "effect", None), "ci": list(getattr(c, "ci", ()))}
@@ -106,6 +110,8 @@ def replication_summary(suite: Suite, runs: dict[int, SuiteRun], pooled: list[Fi
     results = [result for run in runs.values() for result in run.data]
     pooled_groups, pooled_summaries = group_results(results), summarise(results, suite)
     scene_default = load_task(suite.task).objects_per_scene
+    seed_groups = {seed: group_results(run.data) for seed, run in runs.items()}
+    seed_summaries = {seed: {(s.condition, s.strategy): s for s in run.summaries} for seed, run in runs.items()}
     conditions = []
     for condition in suite.conditions:
         rows = []
@@ -113,10 +119,10 @@ def replication_summary(suite: Suite, runs: dict[int, SuiteRun], pooled: list[Fi
             key = (condition.name, summary.strategy)
             row = {"strategy": summary.strategy, "at": int(summary.checkpoints[-1]) if summary.checkpoints else None,
                    "pooled": _cell(pooled_groups[key], summary, suite), "by_data_seed": {}}
-            for seed, run in runs.items():
-                mine = next((s for s in run.summaries if (s.condition, s.strategy) == key), None)
+            for seed in runs:
+                mine = seed_summaries[seed].get(key)
                 if mine is not None and mine.checkpoints:
-                    row["by_data_seed"][str(seed)] = _cell(group_results(run.data)[key], mine, suite)
+                    row["by_data_seed"][str(seed)] = _cell(seed_groups[seed][key], mine, suite)
             rows.append(row)
         conditions.append({"name": condition.name, "budget": condition.budget, "turns": condition.turns,
                            "seconds": condition.seconds, "change_every": condition.change_every,

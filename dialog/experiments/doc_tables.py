@@ -26,10 +26,11 @@ from dialog.experiments.report import numbers_in_words
 from learning.errors import SettingsError
 
 BEGIN = re.compile(r"<!-- experiments:begin (?P<name>[\w.:-]+) -->")
+BEGIN_LINE = "<!-- experiments:begin {name} -->"
 END = "<!-- experiments:end {name} -->"
 STAMP_PREFIX = "<sub>Made by `make experiments`"
 SUMMARIES = ("summary:findings", "summary:demo-share", "summary:wall-times", "summary:suites")
-PARTS = ("results", "findings", "report")
+PARTS = ("results", "findings", "report")  # SUITE:PART blocks: episodes suites write the first two, others "report"
 
 
 @dataclass(frozen=True)
@@ -75,7 +76,7 @@ def load_plan(path: Path) -> Plan:
             raise SettingsError(f"{path}: run {index} ({entry['suite']}): each figure is [report file, docs image "
                                 "name, caption]")
         strategies = entry.get("strategies")
-        runs.append(Run(entry["suite"], tuple(strategies) if strategies else None, figures))  # type: ignore[arg-type]
+        runs.append(Run(entry["suite"], tuple(strategies) if strategies else None, figures))
     if not runs:
         raise SettingsError(f"{path}: no [[run]] entries")
     return Plan(tuple(data.get("docs", [])), tuple(data.get("data_seeds", [0])), tuple(data.get("seeds", [0])),
@@ -106,7 +107,7 @@ def splice(text: str, tables: dict[str, str]) -> tuple[str, list[str]]:
     for name in blocks_in(text):
         if name not in tables:
             continue
-        begin = f"<!-- experiments:begin {name} -->"
+        begin = BEGIN_LINE.format(name=name)
         start = text.index(begin) + len(begin)
         end = text.index(END.format(name=name), start)
         text = text[:start] + "\n" + tables[name].rstrip("\n") + "\n" + text[end:]
@@ -193,10 +194,14 @@ def _seed_cell(cell: dict | None) -> str:
     return f"{'+' if cell['direction'] else '−'} {format_p(cell['p'])}"
 
 
+def verdict_words(holds: bool) -> str:
+    return "**holds**" if holds else "does not hold"
+
+
 def finding_verdict(cell: dict) -> str:
     if not cell["tested"]:
         return "not tested"
-    return "**holds**" if cell["holds"] else "does not hold"
+    return verdict_words(cell["holds"])
 
 
 def findings_table(replication: dict) -> str:
