@@ -32,7 +32,7 @@ from dialog.teachers import ScriptedTeacher
 from dialog.transcript import TranscriptWriter
 from learning.actions import Action, Decision
 from learning.decision.candidates import CandidateFeatures, expected_decision_features
-from learning.decision.features import FEATURE_NAMES
+from learning.decision.habits import EXTENDED_FEATURE_NAMES
 from learning.errors import OutputPathError, SettingsError
 from learning.irl.demonstrations import DecisionTurn, QuestioningEpisode, save_episodes
 from learning.state import LearningState
@@ -96,7 +96,8 @@ class ExpertStrategy(Strategy):
         self.scene = scene
 
     def choose(self, state: LearningState, rng: np.random.Generator) -> Decision:
-        candidates = expected_decision_features(state, self.engine, self.window_factor)
+        # every feature DT-task-env may weigh: the thesis's seven and the expert-habit features (docs/irl.md)
+        candidates = expected_decision_features(state, self.engine, self.window_factor, habits=True)
         if len(candidates.actions) == 1:  # only no query is left: nobody needs to be asked
             action = candidates.actions[0]
             explanation = self.nothing_affordable(state).explanation
@@ -111,7 +112,7 @@ class ExpertStrategy(Strategy):
         return Decision(action, explanation)
 
     def episode(self, name: str, metadata: dict) -> QuestioningEpisode:
-        return QuestioningEpisode(FEATURE_NAMES, tuple(self.turns), name, metadata)
+        return QuestioningEpisode(EXTENDED_FEATURE_NAMES, tuple(self.turns), name, metadata)
 
 
 @dataclass(frozen=True)

@@ -159,7 +159,7 @@ class PersonChooser:
                 command, what = "FSQ", "which features matter?"
             else:
                 command, what = "none", "stay quiet"
-            values = row if action.kind == "none" else row - quiet
+            values = (row if action.kind == "none" else row - quiet)[:len(SHORT_NAMES)]  # the thesis's seven
             cells = [f"{v:.3f}" if action.kind == "none" else f"{v:+.3f}" for v in values]
             table.add_row(command, what, guess, f"{state.cost(action):g}", *cells)
         return table

@@ -4,12 +4,13 @@ The thesis's training condition (§7.4.1), read from the ``ch7-training`` suite 
 prepare-lunch, budget 15, 30 turns, a scene change every 10 turns, costs DQ 2, FSQ 2, LQ 1, NQ 0), played as
 the suite's episodes are: on the cached data sets rendered from the suite's data seed (100, which the ch7 suite
 never uses), demonstration seed s on training pool s mod datasets with episode seed 1000 s + pool, the same
-loop and scripted teacher as `teachbot regress` and IRL's rollouts. One episode per seed; by default training
-episodes 1-3 and validation episodes 4-8 (`teachbot learn-weights` holds the validation ones out).
+loop and scripted teacher as `teachbot regress` and IRL's rollouts. One episode per seed; by default seeds 1-30,
+which `teachbot learn-weights --method imitation` splits three ways (train / validation / held out; docs/irl.md).
+Every turn records the thesis's seven decision features and the expert-habit features (learning.decision.habits).
 Reproducible: every random choice comes from the episode seed. The transcripts go to --transcripts (not
 shipped). --clear removes the old demonstration files in --out first.
 
-    .venv/bin/python scripts/make_expert_demos.py [--seeds 1 2 ... 8] [--data-seed N] [--suite NAME]
+    .venv/bin/python scripts/make_expert_demos.py [--seeds 1 2 ... 30] [--data-seed N] [--suite NAME]
         [--out DIR] [--transcripts DIR] [--clear] [--json]
 """
 
@@ -33,7 +34,7 @@ from dialog.expert import ExpertSettings, run_expert_episode  # noqa: E402
 from dialog.scripted_expert import ScriptedExpertChooser  # noqa: E402
 from learning.irl.learn import SHIPPED_DEMOS  # noqa: E402
 
-DEFAULT_SEEDS = (1, 2, 3, 4, 5, 6, 7, 8)
+DEFAULT_SEEDS = tuple(range(1, 31))
 
 
 def episode_spec(suite, seed: int, data_seed: int) -> EpisodeSpec:

@@ -1,6 +1,8 @@
 """``teachbot learn-weights``: DT-task-env weights from expert demonstrations by maximum-entropy IRL (thesis §7.3.2).
 
-``--method trajectory`` (default): the thesis's trajectory-level fit (eq. 7.7), the learner's feature counts from
+``--method imitation`` (default, issue 27): per-turn MaxEnt fits over three-way splits of the demonstrations and
+random starts, each iterate kept by validation log-likelihood, judged by held-out imitation; the fit shipped is the
+one a rule fixed in advance picks (learning.irl.imitation). ``--method trajectory``: the thesis's trajectory-level fit (eq. 7.7), the learner's feature counts from
 rollouts of the real dialog loop in the training condition (dialog.experiments.irl_rollouts), the iterate kept by
 the final accuracy of greedy episodes on validation seeds. ``--method per-turn``: the per-turn fits of
 learning.irl.maxent, kept by agreement with held-out demonstrations.
@@ -39,9 +41,13 @@ def register(commands) -> None:
                              "'shipped' (learning/irl/expert-demos)")
     parser.add_argument("--out", type=file_argument, required=True, metavar="FILE.toml",
                         help="the weights file to write")
-    parser.add_argument("--method", choices=("trajectory", "per-turn"), default="trajectory",
-                        help="trajectory (default): eq. 7.7 with rollouts of the dialog loop; per-turn: the "
-                             "per-turn MaxEnt fit on the recorded candidates (see --policy)")
+    parser.add_argument("--method", choices=("imitation", "trajectory", "per-turn"), default="imitation",
+                        help="imitation (default): per-turn MaxEnt fits over --split-seeds x --fit-seeds, judged by "
+                             "held-out imitation (docs/irl.md); trajectory: eq. 7.7 with rollouts of the dialog "
+                             "loop; per-turn: one per-turn MaxEnt fit on the recorded candidates (see --policy)")
+    parser.add_argument("--features", choices=("habits", "thesis"), default=None,
+                        help="habits: the thesis's seven decision features and the expert-habit features; thesis: "
+                             "the seven only (default: what the demonstrations record)")
     parser.add_argument("--iterations", type=positive_int, default=100,
                         help="at most this many optimiser iterations (default 100, thesis §7.4.1)")
     parser.add_argument("--seed", type=seed, default=0,
@@ -63,6 +69,13 @@ def register(commands) -> None:
                             help="local worker processes for the rollouts (default: cores)")
     trajectory.add_argument("--ray", metavar="ADDRESS", default=None,
                             help="play the rollouts on the Ray cluster at ADDRESS ('local' starts one here)")
+    imitation = parser.add_argument_group("imitation fit (--method imitation)")
+    imitation.add_argument("--split-seeds", type=seed, nargs="+", default=[0, 1, 2], metavar="N",
+                           help="each seed splits the demonstrations into train / validation / held out (default 0 1 2)")
+    imitation.add_argument("--fit-seeds", type=seed, nargs="+", default=[0, 1, 2, 3, 4], metavar="N",
+                           help="each seed draws a random start for every split (default 0 1 2 3 4)")
+    imitation.add_argument("--report", type=file_argument, default=None, metavar="FILE.json",
+                           help="also write every fit's scores and the baselines to this JSON file")
     per_turn = parser.add_argument_group("per-turn fit (--method per-turn)")
     per_turn.add_argument("--validation", type=positive_int, default=None, metavar="N",
                           help="episodes held out for validation (default: all but three, at least one)")
@@ -87,15 +100,18 @@ def run(args: argparse.Namespace, output_stream=None) -> int:
     method = getattr(args, "method", "per-turn")
     check_options(args, method)
     check_writable(args.out, "weights file")  # before the fit, which takes a while
-    learned = learn_trajectory(args, out) if method == "trajectory" else learn_per_turn(args, out)
-    unidentified = sorted(learned.result.unidentified_features)
+    if getattr(args, "report", None) is not None:
+        check_writable(args.report, "fit report")
+    learned = {"trajectory": learn_trajectory, "per-turn": learn_per_turn, "imitation": learn_imitation}[method](
+        args, out)
+    unidentified = sorted(unidentified_features(learned))
     if unidentified:
         print(f"warning: the demonstrations cannot identify {', '.join(unidentified)} (equal on every candidate of "
               "every demonstrated turn): left at 0", file=sys.stderr, flush=True)
     fitted = UserWeights(str(args.out), tuple(learned.weights.as_dict().items()))
     if fitted.never_asks() and not getattr(args, "allow_degenerate", False):
         raise SettingsError(f"--out {args.out}: nothing written: the fit kept iteration "
-                            f"{learned.result.best_iteration}, whose weights can never ask (every weight but "
+                            f"{learned.weights.provenance.get('best_iteration')}, whose weights can never ask (every weight but "
                             "remaining_time's is 0, so every turn ties with no query); fit with other options "
                             "(e.g. --method trajectory, more "
                             "--iterations), or write them anyway with --allow-degenerate")
@@ -103,32 +119,74 @@ def run(args: argparse.Namespace, output_stream=None) -> int:
     with writing(args.out, "weights file"):
         save_weights(args.out, learned.weights, weights_comment(learned))
     for name, value in learned.weights.as_dict().items():
-        note = "  (unidentified: equal on every candidate)" if name in learned.result.unidentified_features else ""
+        note = "  (unidentified: equal on every candidate)" if name in unidentified else ""
         print(f"  {name:<30} {value:>12.4f}{note}", file=out)
     print(f"wrote {args.out}", file=out)
+    if getattr(args, "report", None) is not None:
+        make_parent(args.report, "fit report")
+        with writing(args.report, "fit report"):
+            args.report.write_text(json.dumps(learned.summary(), indent=1) + "\n", encoding="utf-8")
+        print(f"wrote {args.report}", file=out)
     fitted.warn_if_never_asks()
     if args.json:
         print(json.dumps(learned.summary()), file=out, flush=True)
     return 0
 
 
+def unidentified_features(learned) -> tuple[str, ...]:
+    if hasattr(learned, "result"):
+        return tuple(learned.result.unidentified_features)
+    listed = learned.weights.provenance.get("unidentified_features", "none")
+    return () if listed == "none" else tuple(name.strip() for name in listed.split(","))
+
+
 def check_options(args: argparse.Namespace, method: str) -> None:
     """Options of the other method are refused rather than silently ignored."""
-    given = {"trajectory": [("--validation", getattr(args, "validation", None) is not None),
-                            ("--policy", getattr(args, "policy", "gated") != "gated")],
-             "per-turn": [("--ray", getattr(args, "ray", None) is not None),
-                          ("--start", getattr(args, "start", "per-turn") != "per-turn"),
-                          ("--workers", getattr(args, "workers", None) is not None)]}[method]
+    trajectory_only = [("--ray", getattr(args, "ray", None) is not None),
+                       ("--start", getattr(args, "start", "per-turn") != "per-turn"),
+                       ("--workers", getattr(args, "workers", None) is not None)]
+    imitation_only = [("--split-seeds", getattr(args, "split_seeds", [0, 1, 2]) != [0, 1, 2]),
+                      ("--fit-seeds", getattr(args, "fit_seeds", [0, 1, 2, 3, 4]) != [0, 1, 2, 3, 4]),
+                      ("--report", getattr(args, "report", None) is not None)]
+    per_turn_only = [("--validation", getattr(args, "validation", None) is not None),
+                     ("--policy", getattr(args, "policy", "gated") != "gated")]
+    given = {"trajectory": per_turn_only + imitation_only,
+             "per-turn": trajectory_only + imitation_only,
+             "imitation": trajectory_only + per_turn_only}[method]
     wrong = [name for name, present in given if present]
     if wrong:
         raise SettingsError(f"{', '.join(wrong)} do(es) not apply to --method {method}; see teachbot learn-weights "
                             "--help for the options of each method")
 
 
+def learn_imitation(args: argparse.Namespace, out):
+    from dialog.experiments.irl_rollouts import training_condition
+    from learning.irl.learn import learn_imitation_weights
+
+    features = getattr(args, "features", None) or "habits"
+    context = {"commit": git_commit(), **training_condition().provenance()}
+    learned = learn_imitation_weights(args.demos, tuple(args.split_seeds), tuple(args.fit_seeds), args.iterations,
+                                      features, context)
+    report = learned.report
+    print(f"{len(learned.fits)} per-turn fits ({len(args.split_seeds)} splits x {len(args.fit_seeds)} starts x "
+          f"softmax and gated) in {learned.seconds:.1f} s; kept: {report['policy']}, split seed "
+          f"{report['kept']['split_seed']}, fit seed {report['kept']['fit_seed']} (the median by validation "
+          "log-likelihood)", file=out)
+    spread, kept = report["held_out_spread"], report["kept"]["held_out"]
+    for name in ("exact_agreement", "ask_or_quiet_agreement", "action_kind_agreement", "log_likelihood"):
+        print(f"  held out {name.replace('_', ' ')}: kept {kept[name]:.3f}; {report['policy']} fits "
+              f"{spread[name]['min']:.3f}..{spread[name]['max']:.3f} (median {spread[name]['median']:.3f})", file=out)
+    quiet = report["baselines_on_kept_held_out"]["always_quiet"]["exact_agreement"]
+    uniform = report["baselines_on_kept_held_out"]["uniform_random"]["exact_agreement"]
+    print(f"  beside it on the same held-out turns: always quiet {quiet:.3f}, uniform random {uniform:.3f}", file=out)
+    return learned
+
+
 def learn_per_turn(args: argparse.Namespace, out):
     from learning.irl.learn import learn_weights
 
-    learned = learn_weights(args.demos, args.iterations, args.seed, args.validation, args.policy)
+    learned = learn_weights(args.demos, args.iterations, args.seed, args.validation, args.policy,
+                            getattr(args, "features", None))
     result, provenance = learned.result, learned.weights.provenance
     print(f"{len(learned.train)} training episodes ({result.train_turns} turns with a choice), "
           f"{len(learned.validation)} validation ({result.validation_turns} turns); {result.iterations} iterations, "
@@ -193,7 +251,7 @@ def learn_trajectory(args: argparse.Namespace, out):
         context["rollouts_on"] = pool.where
         rollouts, evaluate = rollout_functions(condition, pool, args.seed, args.validation_episodes)
         learned = learn_trajectory_weights(args.demos, rollouts, evaluate, config, args.train_episodes, context,
-                                           progress)
+                                           progress, getattr(args, "features", None))
     result, provenance = learned.result, learned.weights.provenance
     print(f"kept iteration {result.best_iteration} of {result.iterations}: validation accuracy "
           f"{provenance['validation_accuracy']:.3f}; on the {len(learned.validation)} held-out demonstration(s) "

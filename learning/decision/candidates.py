@@ -30,6 +30,7 @@ import numpy as np
 
 from learning.actions import Action, DemoQuery, FeatureQuery, LabelQuery, NoQuery
 from learning.decision.embodied import absent_chance
+from learning.decision.habits import EXTENDED_FEATURE_NAMES, expected_habits
 from learning.decision.features import (
     FEATURE_NAMES,
     concept_counts,
@@ -78,14 +79,38 @@ def candidate_actions(state) -> tuple[Action, ...]:
 
 
 def expected_decision_features(state, engine: str | WhatIfEngine = "fast", window_factor: float = 1.0,
-                               actions: tuple[Action, ...] | None = None, seconds: bool = True) -> CandidateFeatures:
+                               actions: tuple[Action, ...] | None = None, seconds: bool = True,
+                               habits: bool = False) -> CandidateFeatures:
     """E[phi(s') | a] for every candidate action of ``state`` (thesis eq. 6.3, 7.1) with the given what-if engine.
 
     ``actions`` defaults to ``candidate_actions(state)``; a caller may pass a subset (NoQuery included or not).
     With embodied costs (``state.seconds_clock``; ``seconds`` False ignores them) every row's remaining time is
     read at its own next state in seconds, (T_s - elapsed - E[seconds(a)]) / T_s (thesis §8.2.2), and
-    ``seconds`` of the result holds E[seconds(a)].
+    ``seconds`` of the result holds E[seconds(a)]. ``habits`` appends the expert-habit features of
+    ``learning.decision.habits`` (columns EXTENDED_FEATURE_NAMES; ``current`` keeps the seven).
     """
+    table = _expected_seven(state, engine, window_factor, actions, seconds)
+    if not habits:
+        return table.candidates
+    P, counts = table.probabilities, table.counts
+    demo_weights = {c: _normalised(P[:, y]) for y, c in enumerate(state.concepts)}
+    label_weights = dict(enumerate(label_distribution(P))) if len(P) else {}
+    extra = expected_habits(state, table.candidates.actions, table.outcomes, P, counts, demo_weights, label_weights)
+    seven = table.candidates
+    return CandidateFeatures(seven.actions, np.hstack([seven.expected, extra]), seven.current,
+                             EXTENDED_FEATURE_NAMES, seven.seconds)
+
+
+@dataclass(frozen=True)
+class _SevenFeatureTable:
+    candidates: CandidateFeatures
+    probabilities: np.ndarray
+    counts: np.ndarray
+    outcomes: object  # learning.whatif.Outcomes, or None when no query needed simulating
+
+
+def _expected_seven(state, engine, window_factor, actions, seconds) -> _SevenFeatureTable:
+    """The candidates with E[phi(s') | a] over the thesis's seven features (eq. 6.3, 7.1)."""
     engine = make_engine(engine)
     actions = candidate_actions(state) if actions is None else tuple(actions)
     clock = state_clock(state, window_factor, seconds)
@@ -99,7 +124,8 @@ def expected_decision_features(state, engine: str | WhatIfEngine = "fast", windo
     label_objects = [a.object_index for a in actions if a.kind == "label"]
     wants_feature_query = any(a.kind == "feature" for a in actions)
     if not (label_objects or wants_feature_query or any(a.kind == "demo" for a in actions)):
-        return CandidateFeatures(actions, np.tile(quiet, (len(actions), 1)), current, seconds=durations)
+        return _SevenFeatureTable(CandidateFeatures(actions, np.tile(quiet, (len(actions), 1)), current,
+                                                    seconds=durations), P, counts, None)
     outcomes = engine.simulate(state, label_objects, wants_feature_query)
     n_concepts = len(state.concepts)
     with_one_more = counts + np.eye(n_concepts)  # row y: the counts after one more example of concept y
@@ -135,7 +161,7 @@ def expected_decision_features(state, engine: str | WhatIfEngine = "fast", windo
         if key not in after:
             after[key] = clock.after(key[0], asked=True, seconds=key[1]).features()
         expected[i, learned.shape[1] :] = after[key]
-    return CandidateFeatures(actions, expected, current, seconds=durations)
+    return _SevenFeatureTable(CandidateFeatures(actions, expected, current, seconds=durations), P, counts, outcomes)
 
 
 def _expected_seconds(clock, actions, P: np.ndarray, concepts) -> np.ndarray | None:

@@ -9,7 +9,8 @@ File format (the one the IRL tools write)::
     [provenance]                        # optional: strings, numbers or booleans about where they came from
     method = "hand-set"
 
-Names are those of ``learning.decision.features.FEATURE_NAMES``.
+Names are those of ``learning.decision.features.FEATURE_NAMES`` (the thesis's seven) and, for a feature set
+that weighs the expert's habits too, ``learning.decision.habits.HABIT_FEATURES``.
 """
 
 from __future__ import annotations
@@ -21,32 +22,45 @@ from pathlib import Path
 import numpy as np
 
 from learning.decision.features import FEATURE_NAMES
+from learning.decision.habits import EXTENDED_FEATURE_NAMES, HABIT_FEATURES
 from learning.decision.weights_file import load_weights
 from learning.errors import SettingsError, did_you_mean
 from learning.limits import check_limit
 
 WEIGHTS_DIRECTORY = Path(__file__).resolve().parent / "presets"
-PRESETS = ("dt", "dt-iros", "dt-task", "dt-task-env")
+# dt-task-env weighs the seven and the expert-habit features (issue 27); dt-task-env-thesis is the thesis's seven-feature
+# DT-task-env (the earlier trajectory fit); the last two are issue 27's pre-registered ablations (docs/irl.md).
+PRESETS = ("dt", "dt-iros", "dt-task", "dt-task-env", "dt-task-env-thesis", "dt-task-env-no-env", "dt-task-habits")
 
 
 def weight_vector(weights: Mapping[str, float] | Sequence[float] | np.ndarray, source: str = "weights") -> np.ndarray:
-    """w in FEATURE_NAMES order from a {name: weight} mapping (missing names weigh 0) or a full sequence."""
+    """w from a {name: weight} mapping (missing names weigh 0) or a full sequence: in FEATURE_NAMES order, or in
+    EXTENDED_FEATURE_NAMES order when the mapping names a habit feature (or the sequence has one weight each)."""
     if isinstance(weights, Mapping):
-        unknown = sorted(set(weights) - set(FEATURE_NAMES))
+        unknown = sorted(set(weights) - set(EXTENDED_FEATURE_NAMES))
         if unknown:
-            raise ValueError(f"{source}: unknown decision feature {unknown[0]!r}; accepted: {', '.join(FEATURE_NAMES)}")
-        values = [weights.get(name, 0.0) for name in FEATURE_NAMES]
+            raise ValueError(f"{source}: unknown decision feature {unknown[0]!r}; accepted: "
+                             f"{', '.join(EXTENDED_FEATURE_NAMES)}")
+        names = EXTENDED_FEATURE_NAMES if set(weights) & set(HABIT_FEATURES) else FEATURE_NAMES
+        values = [weights.get(name, 0.0) for name in names]
     else:
         values = list(weights)
-        if len(values) != len(FEATURE_NAMES):
+        names = EXTENDED_FEATURE_NAMES if len(values) == len(EXTENDED_FEATURE_NAMES) else FEATURE_NAMES
+        if len(values) != len(names):
             raise ValueError(f"{source}: expected {len(FEATURE_NAMES)} weights in the order "
-                             f"{', '.join(FEATURE_NAMES)}; got {len(values)}")
-    for name, value in zip(FEATURE_NAMES, values):
+                             f"{', '.join(FEATURE_NAMES)} (or {len(EXTENDED_FEATURE_NAMES)} with "
+                             f"{', '.join(HABIT_FEATURES)} after them); got {len(values)}")
+    for name, value in zip(names, values):
         if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) \
                 or not math.isfinite(value):
             raise ValueError(f"{source}: weight of {name} must be a finite real number, got {value!r}")
         check_limit("weight", abs(value), f"{source}: weight of {name} (its size)")
     return np.array(values, dtype=float)
+
+
+def weighs_habits(weights: np.ndarray) -> bool:
+    """True for a vector over EXTENDED_FEATURE_NAMES (its candidates need the habit columns)."""
+    return len(weights) == len(EXTENDED_FEATURE_NAMES)
 
 
 def load_weight_file(path: str | Path) -> np.ndarray:

@@ -14,7 +14,10 @@ all-cd     All/CD: feature query, a few demos keeping classes uniform, then A
 dt         DT with the weights in learning/decision/presets/dt.toml (or ``weights=``)
 dt-iros    DT on ACD and CDU (thesis ch. 6)
 dt-task    DT on ACD, CDU, IV and PM (thesis ch. 7)
-dt-task-env DT on all seven decision features (thesis ch. 7; IRL weights)
+dt-task-env DT on the seven decision features and the expert-habit ones (thesis ch. 7; IRL weights, issue 27)
+dt-task-env-thesis DT-task-env on the thesis's seven features only (the earlier trajectory-level IRL fit)
+dt-task-env-no-env ablation: dt-task-env's weights without the environment features (docs/irl.md)
+dt-task-habits ablation: DT-task's learning weights with dt-task-env's habit-feature weights (docs/irl.md)
 scripted-expert the scripted expert of thesis §7.4.1 (rules in data/scripted-expert.toml)
 rl:FILE    a trained questioner policy (teachbot train-questioner; beyond the thesis)
 pkg.mod:Cls your own strategy class, imported from an importable module (runs your code; plugins.py)
@@ -55,6 +58,9 @@ STRATEGIES: dict[str, Callable[..., Strategy]] = {
     "dt-iros": partial(DecisionTheoreticStrategy, "dt-iros"),
     "dt-task": partial(DecisionTheoreticStrategy, "dt-task"),
     "dt-task-env": partial(DecisionTheoreticStrategy, "dt-task-env"),
+    "dt-task-env-thesis": partial(DecisionTheoreticStrategy, "dt-task-env-thesis"),
+    "dt-task-env-no-env": partial(DecisionTheoreticStrategy, "dt-task-env-no-env"),
+    "dt-task-habits": partial(DecisionTheoreticStrategy, "dt-task-habits"),
     "scripted-expert": ScriptedExpertStrategy,
     "passive-fs": PassiveFeatureSelectingStrategy,
     "active-fs": ActiveFeatureSelectingStrategy,

@@ -22,13 +22,16 @@ class CandidateStrategy(Strategy):
     window_factor: float
     last_candidates: CandidateFeatures | None = None  # what the last choice saw (for IRL recording)
 
-    def candidates(self, state: LearningState, seconds: bool = True) -> tuple[CandidateFeatures, Decision | None]:
+    def candidates(self, state: LearningState, seconds: bool = True,
+                   habits: bool = False) -> tuple[CandidateFeatures, Decision | None]:
         """This turn's candidates, recorded as ``last_candidates``, and the decision when there is no choice.
 
         The decision is ``nothing_affordable`` when no query is the only candidate (else None: choose).
-        ``seconds`` False ignores embodied costs (time in turns) even when the episode has them.
+        ``seconds`` False ignores embodied costs (time in turns) even when the episode has them; ``habits`` adds
+        the expert-habit features (``learning.decision.habits``).
         """
-        candidates = expected_decision_features(state, self.engine, self.window_factor, seconds=seconds)
+        candidates = expected_decision_features(state, self.engine, self.window_factor, seconds=seconds,
+                                                habits=habits)
         self.last_candidates = candidates
         if len(candidates.actions) == 1:
             return candidates, self.nothing_affordable(state)

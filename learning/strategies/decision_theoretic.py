@@ -28,7 +28,7 @@ from learning.actions import Action, Decision
 from learning.concepts import normalise_rows
 from learning.decision.candidates import CandidateFeatures
 from learning.decision.embodied import choose_per_second
-from learning.decision.weights import resolve_weights
+from learning.decision.weights import resolve_weights, weighs_habits
 from learning.state import LearningState
 from learning.strategies.candidate_based import CandidateStrategy
 from learning.whatif import make_engine
@@ -49,7 +49,7 @@ class DecisionTheoreticStrategy(CandidateStrategy):
         self.last_candidates: CandidateFeatures | None = None  # what the last choice saw (for IRL recording)
 
     def choose(self, state: LearningState, rng: np.random.Generator) -> Decision:
-        candidates, nothing = self.candidates(state, seconds=self.embodied)
+        candidates, nothing = self.candidates(state, seconds=self.embodied, habits=weighs_habits(self.weights))
         if nothing is not None:
             return nothing
         utilities = candidates.utilities(self.weights)

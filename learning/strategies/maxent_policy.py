@@ -14,6 +14,7 @@ import numpy as np
 
 from learning.actions import Decision
 from learning.decision.features import FEATURE_NAMES
+from learning.decision.habits import EXTENDED_FEATURE_NAMES
 from learning.irl.demonstrations import DecisionTurn, QuestioningEpisode
 from learning.irl.policy import policy_probabilities
 from learning.state import LearningState
@@ -22,25 +23,28 @@ from learning.whatif import make_engine
 
 
 class MaxEntPolicyStrategy(CandidateStrategy):
-    """Samples each turn's action from the MaxEnt policy with weights ``weights`` (FEATURE_NAMES order)."""
+    """Samples each turn's action from the MaxEnt policy with weights ``weights`` (FEATURE_NAMES order, or
+    EXTENDED_FEATURE_NAMES order to weigh the expert-habit features too)."""
 
     name = "maxent-policy"
 
     def __init__(self, weights, rng: np.random.Generator, engine="fast", window_factor: float = 1.0):
         weights = np.asarray(weights, dtype=np.float64)
-        if weights.shape != (len(FEATURE_NAMES),) or not np.all(np.isfinite(weights)):
+        if weights.shape not in ((len(FEATURE_NAMES),), (len(EXTENDED_FEATURE_NAMES),)) \
+                or not np.all(np.isfinite(weights)):
             raise ValueError(f"the MaxEnt policy needs {len(FEATURE_NAMES)} finite weights ({', '.join(FEATURE_NAMES)})"
-                             f", got shape {weights.shape}")
+                             f" or {len(EXTENDED_FEATURE_NAMES)} with the habit features, got shape {weights.shape}")
         if not isinstance(rng, np.random.Generator):
             raise ValueError(f"the MaxEnt policy samples with a numpy Generator, got {type(rng).__name__}")
         self.weights, self.rng = weights, rng
         self.engine = make_engine(engine)
         self.window_factor = window_factor
+        self.feature_names = FEATURE_NAMES if len(weights) == len(FEATURE_NAMES) else EXTENDED_FEATURE_NAMES
         self.turns: list[DecisionTurn] = []
 
     def choose(self, state: LearningState, rng: np.random.Generator) -> Decision:
         """One action drawn from P(a|s, w); the episode's generator ``rng`` is left alone (the strategy has its own)."""
-        candidates, nothing = self.candidates(state)
+        candidates, nothing = self.candidates(state, habits=self.feature_names is EXTENDED_FEATURE_NAMES)
         if nothing is not None:
             index, decision = 0, nothing
         else:
@@ -53,4 +57,4 @@ class MaxEntPolicyStrategy(CandidateStrategy):
 
     def episode(self, name: str = "", metadata: dict | None = None) -> QuestioningEpisode:
         """The turns played so far as an IRL episode (what the rollout contributes to eq. 7.7)."""
-        return QuestioningEpisode(FEATURE_NAMES, tuple(self.turns), name, metadata or {})
+        return QuestioningEpisode(self.feature_names, tuple(self.turns), name, metadata or {})
