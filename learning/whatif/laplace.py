@@ -38,6 +38,21 @@ def probit_probability(mean: np.ndarray, variance: np.ndarray) -> np.ndarray:
     return sigmoid(mean / np.sqrt(1.0 + np.pi * np.maximum(variance, MIN_VARIANCE) / 8.0))
 
 
+def _probit_in_place(mean: np.ndarray, variance: np.ndarray) -> np.ndarray:
+    """``probit_probability(mean, variance)`` computed in the arrays given (both are overwritten): the same bits."""
+    np.maximum(variance, MIN_VARIANCE, out=variance)
+    variance *= np.pi
+    variance /= 8.0
+    variance += 1.0
+    np.sqrt(variance, out=variance)
+    np.divide(mean, variance, out=mean)
+    mean *= 0.5  # sigmoid, as gp.sigmoid: 0.5 (1 + tanh(z / 2))
+    np.tanh(mean, out=mean)
+    mean += 1.0
+    mean *= 0.5
+    return mean
+
+
 @dataclass(frozen=True)
 class ScenePosterior:
     """The current Laplace posterior of one classifier, seen from the scene (R&W eq. 3.21, 3.24).
@@ -133,7 +148,10 @@ def one_site_probabilities(posterior: ScenePosterior, max_steps: int = 50, toler
     w = pi * (1.0 - pi)
     shift = (f - mean_t) / site_variance  # (g, 2, m): mean update per unit of Sigma[:, j]
     shrink = w / (1.0 + w * site_variance)  # (g, 2, m)
-    new_mean = mean[:, None, None, :] + cov[:, None, :, :] * shift[..., None]  # [g, t, j, i]
+    # The [g, t, j, i] arrays below are built in place (each the same operations in the same order as
+    # mean + cov shift, along - cov (shrink at_site), diag - cov^2 shrink and probit_probability: the same bits)
+    new_mean = np.multiply(cov[:, None, :, :], shift[..., None])  # [g, t, j, i]
+    new_mean += mean[:, None, None, :]
     if posterior.cross is not None:
         assert posterior.mode is not None and posterior.W is not None, "cross, mode and W are set together"
         cross, mode, W = posterior.cross, posterior.mode[:, None, None, :], posterior.W[:, None, None, :]
@@ -151,10 +169,12 @@ def one_site_probabilities(posterior: ScenePosterior, max_steps: int = 50, toler
         residual += moved
         # Cov(scene, train) r for every (g, t, j), one matrix product per classifier
         along = np.matmul(residual.reshape(n_batch, 2 * m, -1), cross).reshape(n_batch, 2, m, m)
-        at_site = np.diagonal(along, axis1=2, axis2=3)  # (g, t, j)
-        new_mean += along - cov[:, None, :, :] * (shrink * at_site)[..., None]
-    new_variance = diagonal[:, None, None, :] - cov[:, None, :, :] ** 2 * shrink[..., None]
-    return probit_probability(new_mean, new_variance)
+        at_site = np.diagonal(along, axis1=2, axis2=3)  # (g, t, j), a view of along: read before along changes
+        along -= np.multiply(cov[:, None, :, :], (shrink * at_site)[..., None])
+        new_mean += along
+    new_variance = np.multiply(np.square(cov)[:, None, :, :], shrink[..., None])
+    np.subtract(diagonal[:, None, None, :], new_variance, out=new_variance)
+    return _probit_in_place(new_mean, new_variance)
 
 
 def _log_likelihood(targets: np.ndarray, f: np.ndarray) -> np.ndarray:
