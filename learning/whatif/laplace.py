@@ -24,7 +24,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.linalg import solve_triangular
 from scipy.linalg.lapack import spotrf, spotrs, strtrs
 
 from learning.gp import BinaryGPClassifier, rbf_kernel, sigmoid
@@ -36,6 +35,21 @@ MIN_SITE_SCALE = 1e-6  # W^1/2 below this: too small to divide by
 def probit_probability(mean: np.ndarray, variance: np.ndarray) -> np.ndarray:
     """p(y = 1) ~ sigma(mu / sqrt(1 + pi var / 8)), as ``BinaryGPClassifier.predict_proba``."""
     return sigmoid(mean / np.sqrt(1.0 + np.pi * np.maximum(variance, MIN_VARIANCE) / 8.0))
+
+
+def _probit_in_place(mean: np.ndarray, variance: np.ndarray) -> np.ndarray:
+    """``probit_probability(mean, variance)`` computed in the arrays given (both are overwritten): the same bits."""
+    np.maximum(variance, MIN_VARIANCE, out=variance)
+    variance *= np.pi
+    variance /= 8.0
+    variance += 1.0
+    np.sqrt(variance, out=variance)
+    np.divide(mean, variance, out=mean)
+    mean *= 0.5  # sigmoid, as gp.sigmoid: 0.5 (1 + tanh(z / 2))
+    np.tanh(mean, out=mean)
+    mean += 1.0
+    mean *= 0.5
+    return mean
 
 
 @dataclass(frozen=True)
@@ -75,8 +89,8 @@ def scene_posterior(model: BinaryGPClassifier, scene: np.ndarray, kernels: tuple
     factor, lower = model.L_
     sw = model.W_sqrt_
     factor32 = factor.astype(np.float32)  # B's eigenvalues are >= 1: single precision loses ~1e-7
-    V32 = solve_triangular(factor32, (sw[:, None] * K_ns).astype(np.float32), lower=lower, check_finite=False)
-    solved = solve_triangular(factor32, V32, lower=lower, trans="T", check_finite=False).astype(float)  # B^-1 S K_ns
+    V32 = _triangular_solve(factor32, (sw[:, None] * K_ns).astype(np.float32), lower, 0)
+    solved = _triangular_solve(factor32, V32, lower, 1).astype(float)  # B^-1 S K_ns
     V = V32.astype(float)
     cross = solved / np.maximum(sw, MIN_SITE_SCALE)[:, None]
     tiny = np.flatnonzero(sw < MIN_SITE_SCALE)
@@ -84,6 +98,18 @@ def scene_posterior(model: BinaryGPClassifier, scene: np.ndarray, kernels: tuple
         K_tn = rbf_kernel(X[tiny], X, model.length_scale_, model.variance)
         cross[tiny] = K_ns[tiny] - K_tn @ (sw[:, None] * solved)
     return ScenePosterior(K_ns.T @ model.grad_, K_ss - V.T @ V, cross, model.f_hat_, sw * sw)
+
+
+def _triangular_solve(factor: np.ndarray, right: np.ndarray, lower: bool, trans: int) -> np.ndarray:
+    """``scipy.linalg.solve_triangular(factor, right, lower, trans)`` for a float32 factor: the same LAPACK call
+    (strtrs, on the factor or on its transpose, as scipy picks by memory order), without the wrapper's checks."""
+    if factor.flags.f_contiguous:
+        solved, info = strtrs(factor, right, lower=lower, trans=trans)
+    else:
+        solved, info = strtrs(factor.T, right, lower=not lower, trans=1 - trans)
+    if info != 0:
+        raise np.linalg.LinAlgError(f"triangular solve failed (LAPACK strtrs info {info})")
+    return solved
 
 
 def stack_posteriors(posteriors: list[ScenePosterior]) -> ScenePosterior:
@@ -133,7 +159,10 @@ def one_site_probabilities(posterior: ScenePosterior, max_steps: int = 50, toler
     w = pi * (1.0 - pi)
     shift = (f - mean_t) / site_variance  # (g, 2, m): mean update per unit of Sigma[:, j]
     shrink = w / (1.0 + w * site_variance)  # (g, 2, m)
-    new_mean = mean[:, None, None, :] + cov[:, None, :, :] * shift[..., None]  # [g, t, j, i]
+    # The [g, t, j, i] arrays below are built in place (each the same operations in the same order as
+    # mean + cov shift, along - cov (shrink at_site), diag - cov^2 shrink and probit_probability: the same bits)
+    new_mean = np.multiply(cov[:, None, :, :], shift[..., None])  # [g, t, j, i]
+    new_mean += mean[:, None, None, :]
     if posterior.cross is not None:
         assert posterior.mode is not None and posterior.W is not None, "cross, mode and W are set together"
         cross, mode, W = posterior.cross, posterior.mode[:, None, None, :], posterior.W[:, None, None, :]
@@ -151,10 +180,12 @@ def one_site_probabilities(posterior: ScenePosterior, max_steps: int = 50, toler
         residual += moved
         # Cov(scene, train) r for every (g, t, j), one matrix product per classifier
         along = np.matmul(residual.reshape(n_batch, 2 * m, -1), cross).reshape(n_batch, 2, m, m)
-        at_site = np.diagonal(along, axis1=2, axis2=3)  # (g, t, j)
-        new_mean += along - cov[:, None, :, :] * (shrink * at_site)[..., None]
-    new_variance = diagonal[:, None, None, :] - cov[:, None, :, :] ** 2 * shrink[..., None]
-    return probit_probability(new_mean, new_variance)
+        at_site = np.diagonal(along, axis1=2, axis2=3)  # (g, t, j), a view of along: read before along changes
+        along -= np.multiply(cov[:, None, :, :], (shrink * at_site)[..., None])
+        new_mean += along
+    new_variance = np.multiply(np.square(cov)[:, None, :, :], shrink[..., None])
+    np.subtract(diagonal[:, None, None, :], new_variance, out=new_variance)
+    return _probit_in_place(new_mean, new_variance)
 
 
 def _log_likelihood(targets: np.ndarray, f: np.ndarray) -> np.ndarray:

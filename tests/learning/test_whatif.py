@@ -142,3 +142,27 @@ def test_the_feature_query_is_simulated_only_while_it_can_be_asked():
 def test_unknown_engine_is_a_clear_error():
     with pytest.raises(ValueError, match="choose one of: fast, reference"):
         make_engine("quick")
+
+
+def test_the_in_place_arithmetic_gives_the_same_bits_as_the_plain_formulas():
+    """``_probit_in_place`` is ``probit_probability`` and ``_triangular_solve`` is scipy's solve_triangular,
+    to the bit (the decision's tables, and so every transcript, rest on it)."""
+    from scipy.linalg import solve_triangular
+
+    from learning.whatif.laplace import _probit_in_place, _triangular_solve, probit_probability
+
+    rng = np.random.default_rng(3)
+    mean, variance = rng.normal(size=(2, 3, 7, 7)) * 4.0, rng.normal(size=(2, 3, 7, 7)) ** 2
+    variance[0, 0, 0] = -1.0  # below MIN_VARIANCE: clipped in both
+    expected = probit_probability(mean, variance)
+    assert np.array_equal(_probit_in_place(mean.copy(), variance.copy()), expected)
+    A = rng.normal(size=(9, 9))
+    factor = np.linalg.cholesky(A @ A.T + 9.0 * np.eye(9)).astype(np.float32)
+    right = rng.normal(size=(9, 4)).astype(np.float32)
+    for matrix in (factor, np.asfortranarray(factor)):
+        for lower, trans in ((True, 0), (True, 1)):
+            plain = solve_triangular(matrix, right, lower=lower, trans=trans, check_finite=False)
+            assert np.array_equal(_triangular_solve(matrix, right, lower, trans), plain)
+    for matrix in (factor.T, np.asfortranarray(factor.T)):  # an upper factor
+        assert np.array_equal(_triangular_solve(matrix, right, False, 0),
+                              solve_triangular(matrix, right, lower=False, check_finite=False))
