@@ -13,6 +13,8 @@ import math
 from dataclasses import dataclass, field
 from numbers import Integral, Real
 
+from dialog.embodied import make_episode_strategy
+from dialog.user_weights import weights_from_record
 from learning.actions import DEFAULT_COSTS
 from learning.errors import SettingsError
 from learning.limits import check_limit, check_questions
@@ -88,17 +90,11 @@ class EpisodeSettings:
         check_costs(self.costs)
         check_questions(self.turns, self.budget, self.costs)
         if self.weights is not None:
-            from dialog.user_weights import weights_from_record
-
             weights_from_record(self.weights)
 
     def build_strategy(self):
         """The episode's strategy: the named one, or DT with the recorded user weights (shown as ``strategy``)."""
-        from dialog.user_weights import weights_from_record
-
         if self.weights is None:
-            from dialog.embodied import make_episode_strategy
-
             return make_episode_strategy(self.strategy)
         return weights_from_record(self.weights).strategy(self.strategy)
 
