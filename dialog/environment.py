@@ -21,7 +21,7 @@ from bullet_world.annotate import TeacherPicture, location_corners
 from bullet_world.pantry import Spot, free_spots, glimpse, object_poses, replacement_spots, restore_poses
 from bullet_world.viewpoint import Viewpoint
 from bullet_world.world import HiddenObjectError
-from dialog.pictures import annotate_scene, save_picture
+from dialog.language.pictures import annotate_scene, save_picture
 from robot import Arm
 from robot.gestures import point_at
 

@@ -15,22 +15,22 @@ from __future__ import annotations
 
 import time
 from collections import Counter
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
-from dialog import records as checks
 from dialog.clock import VirtualClock
-from dialog.conversation import Outcome, converse
 from dialog.embodied import load_embodied_costs
 from dialog.environment import DEFAULT_TEST_SCENES, Environment, HasTestScenes, SupportsFetch
-from dialog.parsing import AnswerParser
-from dialog.questions import Prompt, Questioner, acknowledgement, question_text
-from dialog.records import action_record, answer_record
-from dialog.replay import replay_turn
-from dialog.settings import DEFAULTS, check_allocation
-from dialog.teachers import as_teacher
-from dialog.transcript import TranscriptWriter
+from dialog.language.parsing import AnswerParser
+from dialog.language.questions import Prompt, Questioner, acknowledgement, question_text
+from dialog.settings import EpisodeConfig
+from dialog.teachers.conversation import Outcome, converse
+from dialog.teachers.protocol import checked_teacher
+from dialog.transcripts import records as checks
+from dialog.transcripts.jsonl import TranscriptWriter
+from dialog.transcripts.records import action_record, answer_record
+from dialog.transcripts.replay import replay_turn
 from learning.actions import Action, NoQuery
 from learning.answers import DemoRow
 from learning.evaluation import accuracy
@@ -41,35 +41,6 @@ __all__ = ["DialogManager", "EpisodeConfig", "EpisodeResult", "episode_generator
 
 STREAMS = ("scenes", "test", "strategy", "teacher", "pantry")
 OBSERVER_EVENTS = ("on_scene", "on_question", "on_answer", "on_turn")
-
-
-@dataclass
-class EpisodeConfig:
-    """One episode's allocation for the manager: T turns, budget B, a scene change every r turns.
-
-    The defaults are :data:`dialog.settings.DEFAULTS`; ``EpisodeSettings.config()`` makes one.
-
-    realtime: seconds per turn (None: turn-based); a late answer counts as none.
-    pictures: folder for numbered scene pictures (None: no pictures).
-    fetch_from_pantry: fetch an example the teacher says is absent, where the task allows.
-    seconds: embodied costs (thesis §8.2.2): the time allocation in seconds (None: in turns); a turn lasts what
-    it takes (pointing, fetching, saying the question, the answer; a quiet turn ``dialog.embodied``'s seconds),
-    the scene changes every ``change_every`` nominal turns of seconds (as in real-time mode), and the episode
-    ends once the seconds are used up or after ``turns`` turns (the cap).
-    """
-
-    turns: int = DEFAULTS.turns
-    budget: float = DEFAULTS.budget
-    change_every: int = DEFAULTS.change_every
-    seed: int = DEFAULTS.seed
-    costs: dict = field(default_factory=lambda: dict(DEFAULTS.costs))
-    realtime: float | None = DEFAULTS.realtime
-    pictures: str | None = None
-    fetch_from_pantry: bool = DEFAULTS.fetch_from_pantry
-    seconds: float | None = None
-
-    def __post_init__(self):
-        check_allocation(self.turns, self.budget, self.change_every, self.realtime, seconds=self.seconds)
 
 
 @dataclass
@@ -103,7 +74,7 @@ class DialogManager:
     def __init__(self, environment: Environment, teacher, strategy: Strategy, config: EpisodeConfig,
                  transcript: TranscriptWriter, rngs: dict[str, np.random.Generator], say=print,
                  observers: tuple = (), clock=None, parser: AnswerParser | None = None, session: dict | None = None):
-        self.env, self.teacher, self.strategy = environment, as_teacher(teacher), strategy
+        self.env, self.teacher, self.strategy = environment, checked_teacher(teacher), strategy
         self.config, self.transcript, self.say = config, transcript, say
         self.rngs = dict(rngs)
         if "pantry" not in self.rngs:
@@ -183,7 +154,7 @@ class DialogManager:
     def begin_turn(self) -> float:
         """Start the next turn (the scene changes when it is due) and return its start time; then ``realise``
         one action. ``play_turn`` does both; a caller that chooses the action itself after seeing the turn's
-        scene (the Gymnasium environment, dialog/gym_env.py) calls them one after the other."""
+        scene (the Gymnasium environment, dialog/rl/gym_env.py) calls them one after the other."""
         return self._start_turn()
 
     def _start_turn(self, recorded_scene: int | None = None) -> float:
@@ -399,7 +370,7 @@ class DialogManager:
 
     # -- resume ---------------------------------------------------------------------------
     def replay_turn(self, record: dict) -> None:
-        """Re-apply one recorded turn and check it against the rebuilt episode (see :mod:`dialog.replay`)."""
+        """Re-apply one recorded turn and check it against the rebuilt episode (:mod:`dialog.transcripts.replay`)."""
         replay_turn(self, record)
 
     def _notify(self, event: str, *payload) -> None:

@@ -14,11 +14,12 @@ from pathlib import Path
 
 from bullet_world.datafiles import available, resolve
 from dialog.clock import VirtualClock, WallClock
+from dialog.episode import make_teacher
 from dialog.manager import DialogManager, episode_generators
-from dialog.records import check_turn_record
 from dialog.settings import EpisodeSettings
-from dialog.teachers import SCRIPTED_OPTIONS, make_teacher
-from dialog.transcript import VERSION, TranscriptWriter, read_numbered_session
+from dialog.teachers.scripted import SCRIPTED_OPTIONS
+from dialog.transcripts.jsonl import VERSION, TranscriptWriter, read_numbered_session
+from dialog.transcripts.records import check_turn_record
 from dialog.user_weights import weights_from_header
 from learning.actions import DEFAULT_COSTS
 from learning.errors import DataFileError, SettingsError, TranscriptError
@@ -188,7 +189,7 @@ def make_clock(settings: SessionSettings, start: float = 0.0):
 
 
 def session_teacher(settings: SessionSettings, rngs, clock, input_stream=None, output_stream=None):
-    """The session's teacher, from its recorded kind and options (``dialog.teachers.make_teacher``)."""
+    """The session's teacher, from its recorded kind and options (``dialog.episode.make_teacher``)."""
     kind = settings.teacher["kind"]
     options = {key: settings.teacher[key] for key in SCRIPTED_OPTIONS if key in settings.teacher and kind == "scripted"}
     delays = None

@@ -13,6 +13,8 @@ import math
 from dataclasses import dataclass, field
 from numbers import Integral, Real
 
+from dialog.embodied import make_episode_strategy
+from dialog.user_weights import weights_from_record
 from learning.actions import DEFAULT_COSTS
 from learning.errors import SettingsError
 from learning.limits import check_limit, check_questions
@@ -88,24 +90,16 @@ class EpisodeSettings:
         check_costs(self.costs)
         check_questions(self.turns, self.budget, self.costs)
         if self.weights is not None:
-            from dialog.user_weights import weights_from_record
-
             weights_from_record(self.weights)
 
     def build_strategy(self):
         """The episode's strategy: the named one, or DT with the recorded user weights (shown as ``strategy``)."""
-        from dialog.user_weights import weights_from_record
-
         if self.weights is None:
-            from dialog.embodied import make_episode_strategy
-
             return make_episode_strategy(self.strategy)
         return weights_from_record(self.weights).strategy(self.strategy)
 
     def config(self, pictures: str | None = None):
         """The manager's allocation for this episode (``pictures``: folder for scene pictures, None: none)."""
-        from dialog.manager import EpisodeConfig  # the manager imports this module
-
         return EpisodeConfig(turns=self.turns, budget=self.budget, change_every=self.change_every, seed=self.seed,
                              costs=dict(self.costs), realtime=self.realtime, pictures=pictures,
                              fetch_from_pantry=self.fetch_from_pantry, seconds=self.seconds)
@@ -120,3 +114,32 @@ def _is_number(value) -> bool:
 
 
 DEFAULTS = EpisodeSettings()
+
+
+@dataclass
+class EpisodeConfig:
+    """One episode's allocation for the manager: T turns, budget B, a scene change every r turns.
+
+    The defaults are :data:`dialog.settings.DEFAULTS`; ``EpisodeSettings.config()`` makes one.
+
+    realtime: seconds per turn (None: turn-based); a late answer counts as none.
+    pictures: folder for numbered scene pictures (None: no pictures).
+    fetch_from_pantry: fetch an example the teacher says is absent, where the task allows.
+    seconds: embodied costs (thesis §8.2.2): the time allocation in seconds (None: in turns); a turn lasts what
+    it takes (pointing, fetching, saying the question, the answer; a quiet turn ``dialog.embodied``'s seconds),
+    the scene changes every ``change_every`` nominal turns of seconds (as in real-time mode), and the episode
+    ends once the seconds are used up or after ``turns`` turns (the cap).
+    """
+
+    turns: int = DEFAULTS.turns
+    budget: float = DEFAULTS.budget
+    change_every: int = DEFAULTS.change_every
+    seed: int = DEFAULTS.seed
+    costs: dict = field(default_factory=lambda: dict(DEFAULTS.costs))
+    realtime: float | None = DEFAULTS.realtime
+    pictures: str | None = None
+    fetch_from_pantry: bool = DEFAULTS.fetch_from_pantry
+    seconds: float | None = None
+
+    def __post_init__(self):
+        check_allocation(self.turns, self.budget, self.change_every, self.realtime, seconds=self.seconds)

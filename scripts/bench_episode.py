@@ -25,8 +25,8 @@ import numpy as np
 
 from dialog.environment import SimulatedKitchen
 from dialog.manager import DialogManager, EpisodeConfig, episode_generators
-from dialog.teachers import ScriptedTeacher
-from dialog.transcript import TranscriptWriter
+from dialog.teachers.scripted import ScriptedTeacher
+from dialog.transcripts.jsonl import TranscriptWriter
 from learning.strategies import make_strategy
 
 GOAL_SECONDS = 10.0

@@ -75,7 +75,7 @@ def repeated_pairs(pairs: int, episodes: int, seed: int) -> dict:
 
 def env_steps_per_second(whatif: bool, episodes: int, seed: int) -> float:
     """The environment playing the very episodes of ``loop_turns_per_second``: same seeds, DT-task's choices."""
-    from dialog.gym_env import QuestioningEnv
+    from dialog.rl.gym_env import QuestioningEnv
     from learning.strategies import make_strategy
 
     env, agent = QuestioningEnv(whatif=whatif), make_strategy("dt-task")
@@ -118,7 +118,7 @@ def loop_turns_per_second(episodes: int, seed: int) -> float:
 
 
 def decision_times(policy_path: Path, episodes: int, seed: int) -> dict:
-    from dialog.gym_env import QuestioningEnv
+    from dialog.rl.gym_env import QuestioningEnv
     from learning.rl.observation import ObservationLayout
     from learning.rl.policy_file import QuestionerPolicy, load_policy
     from learning.strategies import make_strategy
@@ -163,7 +163,7 @@ def main(argv=None) -> int:
     # imports bring scipy's), else its steps ran on two BLAS threads while regress's episodes, which set the
     # limit per episode, ran on one (cho_solve 5x slower in the environment on this machine)
     import dialog.experiments.episodes  # noqa: F401
-    import dialog.gym_env  # noqa: F401
+    import dialog.rl.gym_env  # noqa: F401
     from dialog.threads import one_blas_thread
 
     load_before = os.getloadavg()[0]

@@ -29,8 +29,8 @@ from bullet_world.viewer.mirror import Viewer
 from bullet_world.viewer.snapshot import CHROMIUM_FLAGS, COUNT_DRAWN_JS, find_chromium
 from dialog.environment import SimulatedKitchen
 from dialog.manager import DialogManager, EpisodeConfig, episode_generators
-from dialog.teachers import OracleTeacher
-from dialog.transcript import TranscriptWriter
+from dialog.teachers.scripted import OracleTeacher
+from dialog.transcripts.jsonl import TranscriptWriter
 from learning.strategies import make_strategy
 
 GOAL = 0.20

@@ -33,7 +33,7 @@ from pathlib import Path
 import numpy as np
 
 from bullet_world.viewer.snapshot import CHROMIUM_FLAGS, find_chromium
-from dialog.transcript import read_session
+from dialog.transcripts.jsonl import read_session
 
 TEACHBOT = str(Path(sys.executable).with_name("teachbot"))
 GOAL_MS = 300.0

@@ -30,8 +30,8 @@ sys.path.insert(0, str(ROOT))
 from dialog.experiments.episodes import EpisodeSpec  # noqa: E402
 from dialog.experiments.pools import PoolEnvironment, load_pools  # noqa: E402
 from dialog.experiments.suite import load_suite  # noqa: E402
-from dialog.expert import ExpertSettings, run_expert_episode  # noqa: E402
-from dialog.scripted_expert import ScriptedExpertChooser  # noqa: E402
+from dialog.expert.episode import ExpertSettings, run_expert_episode  # noqa: E402
+from dialog.expert.scripted import ScriptedExpertChooser  # noqa: E402
 from learning.irl.learn import SHIPPED_DEMOS  # noqa: E402
 
 DEFAULT_SEEDS = tuple(range(1, 31))

@@ -14,10 +14,10 @@ from bullet_world.datafiles import DataFileError as WorldDataFileError
 from bullet_world.datafiles import available
 from bullet_world.features import load_feature_catalogue
 from dialog.cli import main
-from dialog.describe import COLOURS_FILE, colour_table
 from dialog.experiments.suite import SUITE_DIR, SuiteError, load_suite, suite_names
-from dialog.scripted_expert import RULES_FILE, ExpertRules
-from dialog.vocabulary import VOCABULARY_FILE, VocabularyError, load_vocabulary
+from dialog.expert.scripted import RULES_FILE, ExpertRules
+from dialog.language.describe import COLOURS_FILE, colour_table
+from dialog.language.vocabulary import VOCABULARY_FILE, VocabularyError, load_vocabulary
 from learning.datafiles import check_keys, numbers, read_toml, value_range
 from learning.decision.weights import PRESETS, preset_weights
 from learning.decision.weights_file import load_weights

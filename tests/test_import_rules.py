@@ -1,6 +1,8 @@
-"""DESIGN.md's import rules: learning stays pure; bullet_world never imports robot or dialog; robot never dialog."""
+"""docs/architecture.md's import rules: learning stays pure; bullet_world never imports robot or dialog; robot never
+dialog; the house has no import circle; inside dialog/ imports run down the layers."""
 
 import ast
+from graphlib import CycleError, TopologicalSorter
 from pathlib import Path
 
 import pytest
@@ -38,3 +40,100 @@ def test_the_checker_catches_a_forbidden_import(tmp_path):
     sample = tmp_path / "bad.py"
     sample.write_text("import numpy\nfrom pybullet import connect\nimport cv2 as vision\n")
     assert imported_top_levels(sample) & RULES["learning"] == {"pybullet", "cv2"}
+
+
+HOUSE = ("bullet_world", "robot", "learning", "dialog")
+# dialog/'s layers, lowest first: a module imports only modules of its own layer or of a lower one
+DIALOG_LAYERS = (
+    ("dialog.clock", "dialog.threads", "dialog.interrupts", "dialog.output_paths"),
+    ("dialog.language", "dialog.environment"),
+    ("dialog.teachers",),
+    ("dialog.transcripts",),
+    ("dialog.embodied", "dialog.user_weights", "dialog.settings", "dialog.manager", "dialog.episode",
+     "dialog.session", "dialog.viewer", "dialog.recipe_session",
+     "dialog.commands._arguments"),  # the argument types the commands, the viewer options and the page share
+    ("dialog.expert", "dialog.experiments", "dialog.rl", "dialog.study", "dialog.web"),
+    ("dialog.commands",),
+    ("dialog.cli",),
+)
+
+
+def house_modules() -> dict[str, Path]:
+    modules = {}
+    for package in HOUSE:
+        for path in (ROOT / package).rglob("*.py"):
+            parts = list(path.relative_to(ROOT).with_suffix("").parts)
+            modules[".".join(parts[:-1] if parts[-1] == "__init__" else parts)] = path
+    return modules
+
+
+def _runs_only_for_type_checkers(node: ast.AST) -> bool:
+    return isinstance(node, ast.If) and isinstance(node.test, ast.Name) and node.test.id == "TYPE_CHECKING"
+
+
+def imported_modules(name: str, path: Path, modules) -> set[str]:
+    """The house modules ``name`` imports anywhere (functions too), but not under ``if TYPE_CHECKING``."""
+    package = name if path.name == "__init__.py" else name.rpartition(".")[0]
+    found: set[str] = set()
+
+    def resolve(target: str) -> None:
+        while target and target not in modules:
+            target = target.rpartition(".")[0]
+        if target and target != name:
+            found.add(target)
+
+    def visit(node: ast.AST) -> None:
+        if _runs_only_for_type_checkers(node):
+            return
+        if isinstance(node, ast.Import):
+            for alias in node.names:
+                resolve(alias.name)
+        elif isinstance(node, ast.ImportFrom):
+            base = node.module or ""
+            if node.level:
+                parent = package.split(".")[: len(package.split(".")) - node.level + 1]
+                base = ".".join([*parent, *([node.module] if node.module else [])])
+            for alias in node.names:
+                resolve(f"{base}.{alias.name}" if f"{base}.{alias.name}" in modules else base)
+        for child in ast.iter_child_nodes(node):
+            visit(child)
+
+    visit(ast.parse(path.read_text(encoding="utf-8"), filename=str(path)))
+    return found
+
+
+def import_graph() -> dict[str, set[str]]:
+    modules = house_modules()
+    return {name: imported_modules(name, path, modules) for name, path in modules.items()}
+
+
+def test_the_house_has_no_import_circle():
+    try:
+        tuple(TopologicalSorter(import_graph()).static_order())
+    except CycleError as error:
+        pytest.fail(f"import circle: {' -> '.join(error.args[1])}")
+
+
+def dialog_layer(module: str) -> int | None:
+    for layer, owners in enumerate(DIALOG_LAYERS):
+        if any(module == owner or module.startswith(owner + ".") for owner in owners):
+            return layer
+    return None
+
+
+def test_every_dialog_module_has_a_layer():
+    assert [m for m in import_graph() if m.startswith("dialog.") and dialog_layer(m) is None] == []
+
+
+def test_imports_inside_dialog_run_down_the_layers():
+    graph = import_graph()
+    upward = sorted(f"{module} -> {target}" for module, targets in graph.items() if module.startswith("dialog.")
+                    for target in targets if target.startswith("dialog.") and target != "dialog"
+                    and dialog_layer(target) > dialog_layer(module))
+    assert upward == []
+
+
+def test_the_graph_sees_imports_inside_functions(tmp_path):
+    sample = tmp_path / "sample.py"
+    sample.write_text("def late():\n    from dialog.cli import main\n")
+    assert imported_modules("dialog.sample", sample, {"dialog.cli": sample, "dialog": sample}) == {"dialog.cli"}

@@ -32,13 +32,6 @@ SESSION_OPTIONS = {
 }
 
 
-def teach_defaults() -> argparse.Namespace:
-    """What ``teachbot teach`` parses when no option is given."""
-    from dialog.cli import build_parser  # here, not at import: the command line imports this module
-
-    return build_parser().parse_args(["teach"])
-
-
 def _same(given, recorded) -> bool:
     if isinstance(given, Path) or isinstance(recorded, Path):
         return recorded is not None and Path(given).resolve() == Path(recorded).resolve()
@@ -60,10 +53,10 @@ def differing_options(args: argparse.Namespace, settings, path: Path, defaults: 
     return found
 
 
-def check_resume_options(args: argparse.Namespace, settings, path: Path) -> None:
-    """Refuse options beside --resume that differ from the recorded session, naming each of them, and a weights
-    file that changed since the session was recorded."""
-    differing = differing_options(args, settings, path, teach_defaults())
+def check_resume_options(args: argparse.Namespace, settings, path: Path, defaults: argparse.Namespace) -> None:
+    """Refuse options beside --resume that differ from the recorded session (``defaults``: what the command parses
+    when no option is given), naming each of them, and a weights file that changed since it was recorded."""
+    differing = differing_options(args, settings, path, defaults)
     if differing:
         raise TranscriptError(f"{path}: a resumed session keeps its recorded settings, but {'; '.join(differing)} "
                               "differ; leave them out, or start a new session without --resume")

@@ -11,17 +11,17 @@ from dialog.clock import VirtualClock
 from dialog.commands._arguments import add_episode_options, add_time_options, resolve_time
 from dialog.commands._arguments import seconds as seconds_type
 from dialog.commands._summary import questions_in_words, scene_size
-from dialog.commands._viewer import DEFAULT_PACE_S, Pacer, add_viewer_option, hold_viewer, pace_of, viewer_observers
 from dialog.commands.teach import DEFAULT_STRATEGY
 from dialog.environment import SimulatedKitchen
 from dialog.experiments.runner import file_label
 from dialog.manager import DialogManager, episode_generators
 from dialog.output_paths import file_argument
 from dialog.settings import DEFAULTS, EpisodeSettings
-from dialog.teachers import OracleTeacher
-from dialog.transcript import FORMAT, TranscriptWriter
-from dialog.transcript_lock import TranscriptLock
+from dialog.teachers.scripted import OracleTeacher
+from dialog.transcripts.jsonl import FORMAT, TranscriptWriter
+from dialog.transcripts.lock import TranscriptLock
 from dialog.user_weights import WEIGHTS_STRATEGY_NAME, add_weights_option, weights_strategy
+from dialog.viewer import DEFAULT_PACE_S, Pacer, add_viewer_option, hold_viewer, pace_of, viewer_observers
 from dialog.web.session import add_web_options, check_web_options
 from learning.errors import TranscriptError
 from learning.strategies import STRATEGY_NAMES, make_strategy

@@ -9,7 +9,7 @@ from pathlib import Path
 
 from dialog.commands._arguments import add_kitchen_option, add_task_option, budget, positive_int, seed
 from dialog.commands._summary import questions_in_words
-from dialog.expert import ExpertSettings
+from dialog.expert.episode import ExpertSettings
 from learning.actions import DEFAULT_COSTS
 
 COST_NAMES = {"lq": "label", "label": "label", "dq": "demo", "demo": "demo", "fsq": "feature", "feature": "feature",
@@ -59,9 +59,9 @@ def register(commands) -> None:
 
 def run(args: argparse.Namespace, input_stream=None, output_stream=None) -> int:
     from dialog.environment import SimulatedKitchen
-    from dialog.expert import ExpertQuit, output_paths, run_expert_episode
-    from dialog.expert_terminal import PersonChooser
-    from dialog.scripted_expert import ScriptedExpertChooser
+    from dialog.expert.episode import ExpertQuit, output_paths, run_expert_episode
+    from dialog.expert.scripted import ScriptedExpertChooser
+    from dialog.expert.terminal import PersonChooser
 
     out = output_stream or sys.stdout
     settings = ExpertSettings(task=args.task, kitchen=args.kitchen, budget=args.budget, turns=args.turns,

@@ -23,7 +23,6 @@ import numpy as np
 
 from bullet_world.recipes.setup import load_recipe_setup
 from dialog.commands._arguments import add_kitchen_option, add_task_option, positive_int, seed
-from dialog.commands._viewer import add_viewer_option, hold_viewer, start_viewer, stop_viewer
 from dialog.recipe_session import (
     NarratedRecipeWorld,
     StepOutcome,
@@ -34,6 +33,7 @@ from dialog.recipe_session import (
     parameter_names,
     recipe_steps,
 )
+from dialog.viewer import add_viewer_option, hold_viewer, start_viewer, stop_viewer
 from learning.recipes.format import Recipe, builtin_recipe_names, load_builtin_recipe, load_recipe
 from learning.recipes.grounding import DEFAULT_TAU, RecipeGrounding
 from robot.grasping import GRASP_MODES

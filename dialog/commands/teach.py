@@ -8,6 +8,7 @@ import sys
 from pathlib import Path
 
 from dialog.commands._arguments import (
+    TeachbotParser,
     add_episode_options,
     add_time_options,
     budget,
@@ -17,14 +18,14 @@ from dialog.commands._arguments import (
 )
 from dialog.commands._resume import check_resume_options, continue_command
 from dialog.commands._summary import questions_in_words, scene_size, session_time
-from dialog.commands._viewer import add_viewer_option, hold_viewer, start_viewer, stop_viewer
 from dialog.environment import SimulatedKitchen
 from dialog.experiments.runner import file_label
 from dialog.output_paths import check_writable, file_argument
 from dialog.session import TEACHERS, SessionSettings, open_session
-from dialog.transcript import read_session
-from dialog.transcript_lock import TranscriptLock
+from dialog.transcripts.jsonl import read_session
+from dialog.transcripts.lock import TranscriptLock
 from dialog.user_weights import add_weights_option, weights_strategy
+from dialog.viewer import add_viewer_option, hold_viewer, start_viewer, stop_viewer
 from dialog.web.session import add_web_options, check_web_options
 from learning.errors import OutputPathError, SettingsError, TranscriptError
 from learning.strategies import STRATEGY_NAMES
@@ -74,6 +75,13 @@ def register(commands) -> None:
     parser.set_defaults(handler=run)
 
 
+def teach_defaults() -> argparse.Namespace:
+    """What ``teachbot teach`` parses when no option is given."""
+    commands = TeachbotParser().add_subparsers()
+    register(commands)
+    return commands.choices["teach"].parse_args([])
+
+
 def _default_transcript(args, strategy: str) -> Path:
     base = Path("runs") / f"teach-{args.task}-{file_label(strategy)}-seed{args.seed}"
     path, number = base.with_suffix(".jsonl"), 2
@@ -108,7 +116,7 @@ def _claim_transcript(args) -> tuple[SessionSettings, Path, TranscriptLock]:
         try:
             header = read_session(args.resume, tolerate_partial_tail=True)[0]
             settings = SessionSettings.from_header(header, args.resume)
-            check_resume_options(args, settings, args.resume)
+            check_resume_options(args, settings, args.resume, teach_defaults())
             return settings, args.resume, lock
         except BaseException:
             lock.release()

@@ -42,11 +42,11 @@ def register(commands) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from bullet_world.viewer.mirror import Viewer
-    from dialog.commands._viewer import page_path
     from dialog.commands.world import scene_table
     from dialog.environment import SimulatedKitchen
     from dialog.manager import episode_generators
     from dialog.output_paths import check_writable, writing
+    from dialog.viewer import page_path
 
     export = None
     if args.export is not None:

@@ -108,7 +108,7 @@ def run_show(args: argparse.Namespace) -> int:
 
 def scene_table(scene, environment) -> list[str]:
     """One line per object: number, kind (and state), concept, perceived colour and size, place and x, y."""
-    from dialog.describe import SceneDescriber
+    from dialog.language.describe import SceneDescriber
 
     described = SceneDescriber(scene, environment.locations, environment.viewpoint)
     width = max([len("object"), *(len(_kind(scene, i)) for i in range(scene.n_objects))])

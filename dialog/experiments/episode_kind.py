@@ -9,8 +9,9 @@ from pathlib import Path
 from dialog.embodied import strategy_names_with_variants
 from dialog.experiments.analysis import evaluate_findings, summarise
 from dialog.experiments.figures import save_figures
-from dialog.experiments.kinds import RunOptions, SuiteKind, SuiteRun, SweepUse, register_kind
+from dialog.experiments.kinds import RunOptions, SuiteKind, SuiteRun, SweepUse
 from dialog.experiments.pools import load_pools
+from dialog.experiments.registry import register_kind
 from dialog.experiments.report import markdown_report, write_episode_csvs
 from dialog.experiments.runner import RenderBar, episode_specs, run_locally, run_on_ray
 from dialog.experiments.suite import Suite, SuiteError

@@ -14,13 +14,13 @@ import numpy as np
 
 from dialog.clock import VirtualClock
 from dialog.embodied import load_embodied_costs, make_episode_strategy
+from dialog.episode import make_teacher
 from dialog.experiments.pools import PoolEnvironment, load_pools
 from dialog.experiments.suite import Condition
 from dialog.manager import DialogManager, episode_generators
 from dialog.settings import EpisodeSettings
-from dialog.teachers import make_teacher
 from dialog.threads import one_blas_thread
-from dialog.transcript import TranscriptWriter, read_transcript
+from dialog.transcripts.jsonl import TranscriptWriter, read_transcript
 from dialog.user_weights import UserWeights
 from learning.errors import SettingsError
 from learning.strategies import Strategy

@@ -10,12 +10,11 @@ asks the registry for it and calls the same four steps on every kind:
     problems = kind.check(run, baseline)      # readable differences from the stored baseline
 
 The built-in kinds (episodes, feature-selection, recipes) register when first
-asked for; another kind registers with ``register_kind``.
+asked for; another kind registers with ``dialog.experiments.registry.register_kind``.
 """
 
 from __future__ import annotations
 
-import importlib
 from abc import ABC, abstractmethod
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -23,10 +22,8 @@ from typing import Any, ClassVar
 
 from dialog.experiments.analysis import CheckpointSummary, FindingResult, skipped_by_overrides
 from dialog.experiments.baseline import BaselineFailures, check_against_baseline
+from dialog.experiments.registry import kind_names, registered
 from dialog.experiments.suite import Suite, SuiteError
-
-BUILTIN_KIND_MODULES = ("dialog.experiments.episode_kind", "dialog.experiments.features.kind",
-                        "dialog.experiments.recipes.kind")
 
 
 @dataclass(frozen=True)
@@ -100,37 +97,13 @@ class SuiteKind(ABC):
         return check_against_baseline(run.suite, run.summaries, baseline)
 
 
-_KINDS: dict[str, SuiteKind] = {}
-
-
-def register_kind(kind: type[SuiteKind]) -> type[SuiteKind]:
-    """Register a ``SuiteKind`` subclass under its ``name`` (usable as a class decorator)."""
-    name = getattr(kind, "name", "")
-    if not isinstance(name, str) or not name:
-        raise TypeError(f"{kind.__name__} needs a non-empty class attribute 'name'")
-    if name in _KINDS and type(_KINDS[name]) is not kind:
-        raise ValueError(f"a suite kind named '{name}' is already registered ({type(_KINDS[name]).__name__})")
-    _KINDS[name] = kind()
-    return kind
-
-
-def _load_builtin_kinds() -> None:
-    for module in BUILTIN_KIND_MODULES:
-        importlib.import_module(module)
-
-
-def kind_names() -> tuple[str, ...]:
-    """The registered kinds, built-in ones first."""
-    _load_builtin_kinds()
-    return tuple(_KINDS)
-
-
 def get_kind(name: str) -> SuiteKind:
     """The registered kind called ``name``; an unknown name is one message listing the registered kinds."""
     names = kind_names()
-    if name not in _KINDS:
+    kinds = registered()
+    if name not in kinds:
         raise SuiteError(f"unknown suite kind '{name}'; registered kinds: {', '.join(names)}")
-    return _KINDS[name]
+    return kinds[name]
 
 
 def run_suite(kind: SuiteKind, suite: Suite, options: RunOptions, original: Suite | None = None) -> SuiteRun:

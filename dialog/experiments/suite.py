@@ -10,6 +10,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
+from dialog.experiments.registry import kind_names
 from learning import datafiles
 from learning.actions import DEFAULT_COSTS
 from learning.datafiles import check_keys, integer, number, numbers, read_toml, section, tables, text, texts
@@ -176,8 +177,6 @@ def load_suite(name_or_path: str | Path, known_strategies=None) -> Suite:
 
 def _suite(table: dict, where: str, known_strategies) -> Suite:
     check_keys(table, where, required=("name", "strategies", "checkpoints"), optional=SUITE_FIELDS)
-    from dialog.experiments.kinds import kind_names  # the registry imports this module
-
     kind = text(table, "kind", where, "episodes", choices=kind_names())
     strategies = texts(table, "strategies", where, nonempty=True)
     if known_strategies is not None and kind == "episodes":

@@ -3,7 +3,7 @@
 sb3-contrib's MaskablePPO (the ``rl`` extra) learns a policy over the
 environment's action slots, never choosing a masked one. The defaults, fixed
 before any chapter-7 comparison: the chapter-7 training condition
-(dialog/gym_env.py), the actor and critic each an MLP of two tanh layers of 64
+(dialog/rl/gym_env.py), the actor and critic each an MLP of two tanh layers of 64
 (stable-baselines3's default), gamma 1 (the episode's return is then the final
 held-out accuracy gain, the quantity the thesis compares), GAE lambda 0.95,
 rollouts of 256 steps per environment, minibatches of 64, 10 epochs, learning
@@ -70,7 +70,7 @@ def require_rl():
 def make_env(options: dict):
     """A factory for one environment (what the vector environment starts in each worker)."""
     def build():
-        from dialog.gym_env import QuestioningEnv
+        from dialog.rl.gym_env import QuestioningEnv
         return QuestioningEnv(**options)
     return build
 

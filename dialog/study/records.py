@@ -14,8 +14,8 @@ import math
 from pathlib import Path
 
 from bullet_world.features import environment_feature_catalogue, object_feature_catalogue, robot_feature_catalogue
-from dialog.records import check_turn_record
-from dialog.transcript import read_numbered_session
+from dialog.transcripts.jsonl import read_numbered_session
+from dialog.transcripts.records import check_turn_record
 from learning.errors import TranscriptError
 
 #: the session header fields a study's condition fixes, and where the condition keeps each

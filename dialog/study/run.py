@@ -29,8 +29,8 @@ from dialog.study.files import (
     write_atomically,
 )
 from dialog.study.records import expected_session
-from dialog.terminal import LineReader
-from dialog.transcript_lock import TranscriptLock
+from dialog.teachers.terminal import LineReader
+from dialog.transcripts.lock import TranscriptLock
 from learning.errors import OutputPathError, TranscriptError
 
 
@@ -237,7 +237,7 @@ class ParticipantRun:
                                        pictures=pictures is not None)
         viewer = None
         try:
-            from dialog.commands._viewer import start_viewer, stop_viewer
+            from dialog.viewer import start_viewer, stop_viewer
 
             want_viewer = condition.viewer if self.viewer is None else self.viewer
             if self.page is not None:  # the page shows this session's kitchen (its 3D view unless --no-viewer)

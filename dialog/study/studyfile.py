@@ -14,7 +14,7 @@ from pathlib import Path
 
 from bullet_world.datafiles import available
 from dialog.settings import DEFAULTS
-from dialog.teachers import SCRIPTED_OPTIONS
+from dialog.teachers.scripted import SCRIPTED_OPTIONS
 from learning import datafiles as df
 from learning.actions import DEFAULT_COSTS
 from learning.errors import DataFileError, SettingsError

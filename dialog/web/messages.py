@@ -3,7 +3,7 @@
 Every message is one JSON object of at most ``MAX_MESSAGE_BYTES`` naming the
 question it answers. Buttons, clicks and checkboxes become the line a person
 would type at the terminal ("fruit", "number 4", "1.1, 1.2", "ignore 2"), so
-the one grammar (``dialog/parsing.py``) reads every answer, whichever way it
+the one grammar (``dialog/language/parsing.py``) reads every answer, whichever way it
 came. A message that is malformed, forged (a concept the task lacks, an object
 the scene lacks, a button the question has no use for) or stale (for an earlier
 question) raises :class:`MessageError` and changes nothing.
@@ -18,7 +18,7 @@ from dataclasses import dataclass
 from learning.errors import MessageError
 
 MAX_MESSAGE_BYTES = 4096
-MAX_TYPED_CHARS = 1000  # the transcript keeps this many characters of a line (dialog/conversation.py)
+MAX_TYPED_CHARS = 1000  # the transcript keeps this many characters of a line (dialog/teachers/conversation.py)
 COMMANDS = ("why", "undo", "skip", "quit", "help", "don't know", "none")
 KINDS = {"typed": ("text",), "concept": ("concept",), "command": ("command",), "object": ("object",),
          "pick": ("object",), "click": ("x", "y"), "features": ("numbers", "mode")}

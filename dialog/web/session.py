@@ -114,7 +114,7 @@ class WebPage:
         self.detach()
         self.teacher.locate = getattr(environment, "picture_pixels", None)
         if self.three_d and getattr(environment, "world", None) is not None:
-            from dialog.commands._viewer import start_viewer
+            from dialog.viewer import start_viewer
 
             export = getattr(self.args, "viewer_export", None)
             self.viewer = start_viewer(argparse.Namespace(viewer=True, viewer_export=export), environment.world)
@@ -123,7 +123,7 @@ class WebPage:
 
     def detach(self) -> None:
         if self.viewer is not None:
-            from dialog.commands._viewer import stop_viewer
+            from dialog.viewer import stop_viewer
 
             viewer, self.viewer = self.viewer, None
             self.server.meshcat_socket_url = None

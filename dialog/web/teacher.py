@@ -1,4 +1,4 @@
-"""The person at the page: the session's side of ``--web`` (a :class:`~dialog.teachers.Teacher`).
+"""The person at the page: the session's side of ``--web`` (a :class:`~dialog.teachers.scripted.Teacher`).
 
 The dialog runs in the main thread as for ``teach``; the web server
 (:mod:`dialog.web.server`) runs in its own thread and hands each message from a
@@ -18,7 +18,7 @@ import threading
 
 import numpy as np
 
-from dialog.questions import Prompt, help_text
+from dialog.language.questions import Prompt, help_text
 from dialog.web.messages import Asked, PageAnswer, decode, read_message, read_screen
 from learning.errors import MessageError
 

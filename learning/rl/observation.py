@@ -18,7 +18,7 @@ and the observation, all in [0, 1]:
                               zeros where the slot is not a candidate (``whatif=False`` leaves them out)
     mask                      1 where the slot is a candidate this turn (affordable, present), |slots| values
 
-The same encoding serves the Gymnasium environment (dialog/gym_env.py) and the
+The same encoding serves the Gymnasium environment (dialog/rl/gym_env.py) and the
 strategy that runs a trained policy (learning/strategies/rl_questioner.py), so a
 policy sees in ``teachbot demo`` exactly what it saw in training.
 """

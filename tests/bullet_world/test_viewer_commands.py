@@ -9,7 +9,7 @@ import pytest
 
 from bullet_world.viewer import thread as viewer_thread
 from bullet_world.viewer.server import ViewerError
-from dialog.commands._viewer import add_viewer_option, start_viewer, stop_viewer, viewer_observers
+from dialog.viewer import add_viewer_option, start_viewer, stop_viewer, viewer_observers
 from tests.bullet_world.test_viewer import BareWorld
 
 
@@ -60,8 +60,8 @@ def test_live_viewer_prints_its_loopback_url_and_closes(capsys):
 def test_an_episode_with_viewer_export_writes_its_page(tmp_path, capsys):
     from dialog.environment import SimulatedKitchen
     from dialog.manager import DialogManager, EpisodeConfig, episode_generators
-    from dialog.teachers import OracleTeacher
-    from dialog.transcript import TranscriptWriter
+    from dialog.teachers.scripted import OracleTeacher
+    from dialog.transcripts.jsonl import TranscriptWriter
     from learning.strategies import make_strategy
 
     page = tmp_path / "episode.html"

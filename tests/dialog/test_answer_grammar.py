@@ -13,9 +13,9 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from dialog.feature_tree import FeatureTree
-from dialog.parsing import AnswerParser
-from dialog.vocabulary import load_vocabulary, tokens
+from dialog.language.feature_tree import FeatureTree
+from dialog.language.parsing import AnswerParser
+from dialog.language.vocabulary import load_vocabulary, tokens
 
 CONCEPTS = ("main dish", "snack", "fruit", "beverage")
 N_OBJECTS = 12

@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 
 from dialog.clock import VirtualClock
-from dialog.conversation import converse
-from dialog.parsing import AnswerParser
-from dialog.questions import Prompt
+from dialog.language.parsing import AnswerParser
+from dialog.language.questions import Prompt
+from dialog.teachers.conversation import converse
 from learning.actions import DemoQuery, FeatureQuery, LabelQuery
 from tests.dialog.fakes import CONCEPTS, FakeEnvironment
 
@@ -83,7 +83,7 @@ def test_end_of_input_is_quit_and_a_late_answer_counts_as_none(scene):
 
 
 def test_a_feature_answer_is_read_against_the_tree(scene):
-    from dialog.feature_tree import FeatureTree
+    from dialog.language.feature_tree import FeatureTree
 
     tree = FeatureTree(("colour.red", "colour.green", "size.length", "weight"),
                        [("object/colour", ""), ("object/colour", ""), ("object/size", ""), ("object", "")])

@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 
 from bullet_world.scene import Scene, SceneTruth
-from dialog.describe import SceneDescriber, colour_name, place_phrase, shape_words
-from dialog.pictures import annotate_scene, project_points
+from dialog.language.describe import SceneDescriber, colour_name, place_phrase, shape_words
+from dialog.language.pictures import annotate_scene, project_points
 
 
 @pytest.mark.parametrize("rgb, name", [

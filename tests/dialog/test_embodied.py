@@ -15,8 +15,8 @@ from dialog.embodied import (
     make_episode_strategy,
 )
 from dialog.manager import DialogManager, EpisodeConfig, episode_generators
-from dialog.teachers import ScriptedTeacher
-from dialog.transcript import TranscriptWriter, read_session, read_transcript
+from dialog.teachers.scripted import ScriptedTeacher
+from dialog.transcripts.jsonl import TranscriptWriter, read_session, read_transcript
 from learning.errors import DataFileError, SettingsError
 from tests.dialog.fakes import FakeEnvironment, QuittingTeacher
 

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from dialog.cli import main
-from dialog.experiments import kinds, pools
+from dialog.experiments import kinds, pools, registry
 from dialog.experiments.analysis import evaluate_findings, skipped_by_overrides, summarise
 from dialog.experiments.baseline import make_baseline
 from dialog.experiments.figures import learning_curve_figure, strategy_styles, timing_figure
@@ -88,8 +88,8 @@ def fake_results(suite, seeds=(0, 1)):
 
 
 def test_every_kind_is_registered_and_an_unknown_kind_lists_them(tmp_path, capsys):
-    assert kinds.kind_names()[:3] == ("episodes", "feature-selection", "recipes")
-    assert all(kinds.get_kind(name).name == name for name in kinds.kind_names())
+    assert registry.kind_names()[:3] == ("episodes", "feature-selection", "recipes")
+    assert all(kinds.get_kind(name).name == name for name in registry.kind_names())
     with pytest.raises(SuiteError, match="unknown suite kind 'nope'; registered kinds: episodes, "
                                          "feature-selection, recipes"):
         kinds.get_kind("nope")
@@ -111,8 +111,8 @@ def test_a_registered_kind_is_run_by_the_command(tmp_path, capsys, monkeypatch):
             path.write_text("counted " + ", ".join(run.data))
             return [path]
 
-    monkeypatch.setattr(kinds, "_KINDS", dict(kinds._KINDS))  # the registration ends with the test
-    kinds.register_kind(Counting)
+    monkeypatch.setattr(registry, "_KINDS", dict(registry._KINDS))  # the registration ends with the test
+    registry.register_kind(Counting)
     path = suite_file(tmp_path, 'name = "c"\nkind = "counting"\nstrategies = ["a", "b"]\ncheckpoints = [1]\n')
     assert main(["regress", "--suite", str(path), "--results", str(tmp_path / "out"), "--no-progress"]) == 0
     assert "c: 2 runs in 0.0 s" in capsys.readouterr().out

@@ -6,8 +6,8 @@ import math
 import numpy as np
 import pytest
 
-from dialog.expert import ExpertQuit, ExpertSettings, ExpertStrategy, run_expert_episode
-from dialog.scripted_expert import ScriptedExpertChooser, paced_budget
+from dialog.expert.episode import ExpertQuit, ExpertSettings, ExpertStrategy, run_expert_episode
+from dialog.expert.scripted import ScriptedExpertChooser, paced_budget
 from learning.actions import DEFAULT_COSTS
 from learning.decision.candidates import expected_decision_features
 from learning.irl.demonstrations import load_episodes
@@ -101,7 +101,7 @@ def test_an_expert_strategy_refuses_a_choice_that_is_not_a_candidate():
 def test_person_commands_are_parsed_and_bad_ones_explained(tmp_path):
     import io
 
-    from dialog.expert_terminal import PersonChooser
+    from dialog.expert.terminal import PersonChooser
 
     typed = io.StringIO("help\nbogus\nLQ 99\nDQ pizza\nFSQ\nDQ fruit\n1\nnone\n")
     shown = io.StringIO()
@@ -116,8 +116,8 @@ def test_person_commands_are_parsed_and_bad_ones_explained(tmp_path):
 def test_the_scripted_expert_strategy_asks_what_expert_mode_asks(tmp_path):
     """One plan in two places: `scripted-expert` in the manager = `teachbot expert --expert scripted`."""
     from dialog.manager import DialogManager, episode_generators
-    from dialog.teachers import ScriptedTeacher
-    from dialog.transcript import TranscriptWriter, read_transcript
+    from dialog.teachers.scripted import ScriptedTeacher
+    from dialog.transcripts.jsonl import TranscriptWriter, read_transcript
     from learning.strategies import make_strategy
 
     recorded = scripted_episode(tmp_path, 7)

@@ -2,7 +2,7 @@
 
 import pytest
 
-from dialog.feature_tree import FeatureTree
+from dialog.language.feature_tree import FeatureTree
 
 NAMES = ("colour.red", "colour.green", "colour.blue", "size.length", "size.height", "weight", "arm.joint1",
          "hand.x")
@@ -139,10 +139,10 @@ def test_the_question_stays_open_after_more_and_the_list_is_not_reprinted_after_
     import numpy as np
 
     from dialog.clock import VirtualClock
-    from dialog.conversation import converse
-    from dialog.parsing import AnswerParser
-    from dialog.questions import Prompt
-    from dialog.terminal import TerminalTeacher
+    from dialog.language.parsing import AnswerParser
+    from dialog.language.questions import Prompt
+    from dialog.teachers.conversation import converse
+    from dialog.teachers.terminal import TerminalTeacher
     from learning.actions import FeatureQuery
     from tests.dialog.fakes import CONCEPTS, FakeEnvironment
 

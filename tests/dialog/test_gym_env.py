@@ -5,7 +5,7 @@ import pytest
 
 gym = pytest.importorskip("gymnasium", reason="the rl extra (pip install -e '.[rl]') installs gymnasium")
 
-from dialog.gym_env import ENV_ID, QuestioningEnv  # noqa: E402
+from dialog.rl.gym_env import ENV_ID, QuestioningEnv  # noqa: E402
 from learning.errors import SettingsError  # noqa: E402
 
 SMALL = {"turns": 8, "budget": 8.0, "change_every": 4}  # the training condition's task and data, shorter
@@ -114,7 +114,7 @@ def test_async_vector_envs_step_and_agree_with_a_single_env():
 # -- issue 24: Gymnasium's conventions; every argument checked, none ignored --------------------------------
 @pytest.mark.parametrize("action", [1.7, "0", True, np.bool_(True), np.float64(1.0), np.array([1]), None])
 def test_an_action_outside_the_action_space_raises_as_gymnasium_envs_do(action):
-    from dialog.gym_env import InvalidActionError
+    from dialog.rl.gym_env import InvalidActionError
 
     env = QuestioningEnv(**SMALL)
     env.reset(seed=0)

@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 from dialog.manager import DialogManager, EpisodeConfig, episode_generators
-from dialog.teachers import Answer, OracleTeacher
-from dialog.transcript import TranscriptWriter, read_transcript
+from dialog.teachers.scripted import OracleTeacher
+from dialog.transcripts.jsonl import TranscriptWriter, read_transcript
 from learning.strategies import make_strategy
 from tests.dialog.fakes import FakeEnvironment, QuittingTeacher
 
@@ -51,11 +51,8 @@ def test_label_queries_point_first_and_learning_helps(tmp_path):
 
 
 def test_a_demo_of_an_absent_concept_adds_nothing(tmp_path):
-    class NothingHere:
-        def answer(self, action, question, scene):
-            return Answer("there is none", None)
-
-    result, _, records = run_episode(tmp_path, "passive", teacher=NothingHere(), turns=3, budget=10)
+    result, _, records = run_episode(tmp_path, "passive", teacher=LineTeacher(["there is none"] * 3), turns=3,
+                                     budget=10)
     assert all(sum(r["model"]["examples"].values()) == 0 for r in records)
     assert result.budget_spent == 6
 
@@ -108,8 +105,8 @@ def test_observers_see_every_scene_and_turn(tmp_path):
 
 # -- the full loop: every action kind, budget rules, real time, undo, resume ------------------------------------
 from dialog.clock import VirtualClock  # noqa: E402
-from dialog.teachers import ScriptedTeacher  # noqa: E402
-from dialog.transcript import read_session  # noqa: E402
+from dialog.teachers.scripted import ScriptedTeacher  # noqa: E402
+from dialog.transcripts.jsonl import read_session  # noqa: E402
 from learning.actions import DemoQuery, FeatureQuery, LabelQuery, NoQuery  # noqa: E402
 from tests.dialog.fakes import PantryEnvironment, ScriptedStrategy  # noqa: E402
 
@@ -356,7 +353,7 @@ def test_undo_takes_back_a_feature_choice_and_a_pantry_example(tmp_path):
 def test_undo_gives_the_budget_back_for_every_query_kind(tmp_path, first, answer, cost):
     """Issue 23 case 7: an undone answer used to keep its budget spent, and an undone feature answer closed the
     feature question for good. Now the budget comes back and the feature question may be asked again."""
-    from dialog.terminal import TerminalTeacher
+    from dialog.teachers.terminal import TerminalTeacher
     out = io.StringIO()
     teacher = TerminalTeacher(io.StringIO(f"{answer}\nundo\na snack\nf3\n"), out, clock=VirtualClock())
     env = PantryEnvironment(missing=("fruit",) if answer == "none" else ())

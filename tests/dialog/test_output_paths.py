@@ -15,7 +15,7 @@ import pytest
 
 from dialog.cli import main
 from dialog.output_paths import check_writable, writing
-from dialog.transcript import TranscriptWriter, read_session
+from dialog.transcripts.jsonl import TranscriptWriter, read_session
 from learning.errors import OutputPathError
 
 CAN_MOUNT = hasattr(os, "geteuid") and os.geteuid() == 0 and shutil.which("mount") is not None
@@ -257,7 +257,7 @@ def test_demo_viewer_export_that_cannot_be_written_is_a_warning(tmp_path, mount,
 
 
 def test_a_viewer_export_that_fails_on_close_is_one_warning_naming_the_page(tmp_path, capsys):
-    from dialog.commands._viewer import stop_viewer
+    from dialog.viewer import stop_viewer
 
     class FullDiskViewer:
         export_path = tmp_path / "episode.html"

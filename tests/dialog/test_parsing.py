@@ -2,8 +2,8 @@
 
 import pytest
 
-from dialog.parsing import AnswerParser, edit_distance, typo_tolerance
-from dialog.vocabulary import VocabularyError, clean, load_vocabulary, phrase, plural
+from dialog.language.parsing import AnswerParser, edit_distance, typo_tolerance
+from dialog.language.vocabulary import VocabularyError, clean, load_vocabulary, phrase, plural
 
 CONCEPTS = ("main dish", "snack", "fruit", "beverage")
 

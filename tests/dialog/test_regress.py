@@ -220,7 +220,7 @@ def test_a_strategy_subset_says_which_findings_it_skips(tmp_path, capsys):
 
 def test_the_pack_lunchbox_experiments_run_on_55_object_scenes(tmp_path, capsys):
     """Issue 26 item 1: the thesis's pack-lunchbox scenes hold 55 objects (§6.5); the suites drew 12."""
-    from dialog.transcript import read_session
+    from dialog.transcripts.jsonl import read_session
     assert {c.objects_per_scene for c in load_suite("ch6-static").conditions} == {55}
     assert {c.objects_per_scene for c in load_suite("ch7-pack-lunchbox").conditions} == {55}
     assert {c.objects_per_scene for c in load_suite("smoke").conditions} == {None}  # the task's 12

@@ -7,9 +7,9 @@ import pytest
 pytest.importorskip("sb3_contrib", reason="the rl extra (pip install -e '.[rl]') installs sb3-contrib")
 
 from dialog.cli import main  # noqa: E402
-from dialog.gym_env import QuestioningEnv  # noqa: E402
+from dialog.rl.gym_env import QuestioningEnv  # noqa: E402
 from dialog.rl.training import actor_policy  # noqa: E402
-from dialog.transcript import read_session  # noqa: E402
+from dialog.transcripts.jsonl import read_session  # noqa: E402
 from learning.rl.policy_file import load_policy  # noqa: E402
 
 TINY = ["--turns", "8", "--budget", "8", "--change-every", "4"]

@@ -9,28 +9,20 @@ import pytest
 
 from dialog.cli import build_parser
 from dialog.clock import VirtualClock
-from dialog.conversation import OUTCOME_KINDS
+from dialog.episode import make_teacher
 from dialog.experiments.episodes import EpisodeSpec, suite_teacher
 from dialog.experiments.suite import Condition
-from dialog.expert import ExpertSettings
+from dialog.expert.episode import ExpertSettings
+from dialog.language.questions import Questioner
 from dialog.manager import DialogManager, EpisodeConfig, episode_generators
-from dialog.questions import Questioner
-from dialog.records import ANSWER_KINDS
 from dialog.session import SessionSettings, session_teacher
 from dialog.settings import DEFAULTS, EpisodeSettings
-from dialog.teachers import (
-    Answer,
-    FastForwards,
-    OracleTeacher,
-    PreParsedTeacher,
-    ReplayTeacher,
-    ScriptedTeacher,
-    Teacher,
-    as_teacher,
-    make_teacher,
-)
-from dialog.terminal import TerminalTeacher
-from dialog.transcript import TranscriptWriter
+from dialog.teachers.conversation import OUTCOME_KINDS
+from dialog.teachers.protocol import FastForwards, Teacher, checked_teacher
+from dialog.teachers.scripted import OracleTeacher, ReplayTeacher, ScriptedTeacher
+from dialog.teachers.terminal import TerminalTeacher
+from dialog.transcripts.jsonl import TranscriptWriter
+from dialog.transcripts.records import ANSWER_KINDS
 from learning.actions import ACTION_KINDS, DEFAULT_COSTS, DemoQuery, FeatureQuery, LabelQuery, NoQuery
 from learning.errors import SettingsError
 from learning.state import LearningState
@@ -178,16 +170,9 @@ def test_observers_get_only_the_events_they_handle(tmp_path):
 def test_one_teacher_protocol():
     rng = episode_generators(0)["teacher"]
     scripted = ScriptedTeacher(rng)
-    assert as_teacher(scripted) is scripted
-
-    class Older:
-        def answer(self, action, question, scene):
-            return Answer("there is none", None)
-
-    wrapped = as_teacher(Older())
-    assert isinstance(wrapped, PreParsedTeacher)
+    assert checked_teacher(scripted) is scripted
     with pytest.raises(TypeError, match="is not a teacher"):
-        as_teacher(object())
+        checked_teacher(object())
 
 
 def test_one_teacher_factory_for_every_kind(tmp_path):

@@ -4,10 +4,10 @@ import numpy as np
 import pytest
 
 from dialog.clock import VirtualClock
-from dialog.feature_tree import FeatureTree
-from dialog.parsing import AnswerParser
-from dialog.questions import Prompt
-from dialog.teachers import OracleTeacher, ReplayTeacher, ScriptedTeacher
+from dialog.language.feature_tree import FeatureTree
+from dialog.language.parsing import AnswerParser
+from dialog.language.questions import Prompt
+from dialog.teachers.scripted import OracleTeacher, ReplayTeacher, ScriptedTeacher
 from learning.actions import DemoQuery, FeatureQuery, LabelQuery
 from learning.errors import SettingsError
 from tests.dialog.fakes import CONCEPTS, FakeEnvironment

@@ -7,11 +7,11 @@ import numpy as np
 import pytest
 
 from dialog.clock import VirtualClock
-from dialog.conversation import converse
-from dialog.feature_tree import FeatureTree
-from dialog.parsing import AnswerParser
-from dialog.questions import Prompt
-from dialog.terminal import TIMEOUT, LineReader, TerminalTeacher
+from dialog.language.feature_tree import FeatureTree
+from dialog.language.parsing import AnswerParser
+from dialog.language.questions import Prompt
+from dialog.teachers.conversation import converse
+from dialog.teachers.terminal import TIMEOUT, LineReader, TerminalTeacher
 from learning.actions import DemoQuery, FeatureQuery, LabelQuery
 from tests.dialog.fakes import CONCEPTS, FakeEnvironment
 
@@ -78,8 +78,8 @@ def test_real_time_mode_counts_down_at_the_prompt(scene, monkeypatch):
     """Issue 23 case 11: real-time mode said how long there was only once, above the question."""
     import re
 
-    import dialog.terminal
-    monkeypatch.setattr(dialog.terminal, "COUNTDOWN_MARKS", (1.4, 0.6))
+    import dialog.teachers.terminal
+    monkeypatch.setattr(dialog.teachers.terminal, "COUNTDOWN_MARKS", (1.4, 0.6))
     stream, write_fd = make_pipe(b"")
     out = io.StringIO()
     clock = VirtualClock(0.0)

@@ -5,7 +5,7 @@ import json
 import numpy as np
 import pytest
 
-from dialog.transcript import TranscriptWriter, drop_partial_tail, read_session, read_transcript
+from dialog.transcripts.jsonl import TranscriptWriter, drop_partial_tail, read_session, read_transcript
 
 
 def test_header_then_turns(tmp_path):
@@ -79,7 +79,7 @@ def test_a_session_recorded_with_other_concepts_or_features_is_refused():
 
 
 def test_turn_records_come_with_their_line_numbers(tmp_path):
-    from dialog.transcript import read_numbered_session
+    from dialog.transcripts.jsonl import read_numbered_session
 
     path = tmp_path / "t.jsonl"
     path.write_text('{"session": {"format": "teachbot-transcript"}}\n\n{"turn": 1}\n{"turn": 2}\n')
@@ -113,7 +113,7 @@ def test_a_bad_line_is_described_in_full_with_its_column(tmp_path):
 
 
 def test_a_long_bad_value_is_shortened_and_says_so():
-    from dialog.records import check_turn_record
+    from dialog.transcripts.records import check_turn_record
     from learning.errors import TranscriptError
 
     with pytest.raises(TranscriptError) as raised:
@@ -150,7 +150,7 @@ def good_record(**changes):
     ({"fetched": {"position": [0, 0, 0]}}, "'fetched.kind' is null"),
 ])
 def test_a_malformed_turn_record_names_the_field_and_what_is_accepted(changes, fragment):
-    from dialog.records import check_turn_record
+    from dialog.transcripts.records import check_turn_record
     from learning.errors import TranscriptError
     from tests.dialog.fakes import CONCEPTS
 
@@ -161,7 +161,7 @@ def test_a_malformed_turn_record_names_the_field_and_what_is_accepted(changes, f
 
 
 def test_scene_and_gesture_fingerprints():
-    from dialog.records import gesture_difference, scene_check, scene_difference
+    from dialog.transcripts.records import gesture_difference, scene_check, scene_difference
     from tests.dialog.fakes import FakeEnvironment
 
     scene = FakeEnvironment().next_scene(np.random.default_rng(0))

@@ -5,7 +5,7 @@ import io
 
 import pytest
 
-from dialog.commands._viewer import add_viewer_option, hold_viewer
+from dialog.viewer import add_viewer_option, hold_viewer
 
 
 class FakeViewer:

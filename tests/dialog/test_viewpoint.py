@@ -10,9 +10,9 @@ from bullet_world.annotate import TeacherPicture, outlined_text
 from bullet_world.kitchen import load_kitchen
 from bullet_world.scene import Scene, SceneTruth
 from bullet_world.viewpoint import Viewpoint, picture_turn, turn_image, turn_pixels
-from dialog.describe import OLD_WORLD_VIEWPOINT, SceneDescriber, area_phrase
-from dialog.expert_terminal import COLUMN_MEANINGS, SHORT_NAMES, guess_text, help_text
-from dialog.records import question_difference
+from dialog.expert.terminal import COLUMN_MEANINGS, SHORT_NAMES, guess_text, help_text
+from dialog.language.describe import OLD_WORLD_VIEWPOINT, SceneDescriber, area_phrase
+from dialog.transcripts.records import question_difference
 from learning.actions import LabelQuery
 
 
@@ -105,7 +105,7 @@ def test_a_transcript_with_the_old_side_words_still_resumes():
     now = SceneDescriber(scene, {}, Viewpoint.of_kitchen(load_kitchen("kitchen-1")))
     old = SceneDescriber(scene, {}, OLD_WORLD_VIEWPOINT)
     assert now.describe(0).endswith("at the back right") and old.describe(0).endswith("at the front left")
-    from dialog.questions import question_text
+    from dialog.language.questions import question_text
 
     action = LabelQuery(0)
     recorded = question_text(action, description=old.describe(0))
@@ -124,7 +124,7 @@ def test_expert_help_explains_every_column_and_ties_make_no_guess():
 
 
 def test_the_expert_table_has_its_key_and_help_prints_the_columns(tmp_path):
-    from dialog.expert_terminal import PersonChooser
+    from dialog.expert.terminal import PersonChooser
     from tests.dialog.test_expert import scripted_episode
 
     shown = io.StringIO()

@@ -5,7 +5,7 @@ import json
 import pytest
 
 from dialog.cli import main
-from dialog.transcript import read_transcript
+from dialog.transcripts.jsonl import read_transcript
 
 pytestmark = pytest.mark.e2e
 

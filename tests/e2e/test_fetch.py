@@ -10,7 +10,7 @@ import dialog.environment as environment
 from bullet_world.world import HiddenObjectError
 from dialog.cli import main
 from dialog.environment import SimulatedKitchen
-from dialog.transcript import read_session
+from dialog.transcripts.jsonl import read_session
 
 pytestmark = pytest.mark.e2e
 

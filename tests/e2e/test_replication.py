@@ -5,7 +5,7 @@ import json
 import pytest
 
 from dialog.cli import main
-from dialog.transcript import read_session
+from dialog.transcripts.jsonl import read_session
 from learning.decision.weights_file import DecisionWeights, save_weights
 
 pytestmark = pytest.mark.e2e

@@ -9,7 +9,7 @@ from pathlib import Path
 import pexpect
 import pytest
 
-from dialog.transcript import read_session
+from dialog.transcripts.jsonl import read_session
 from tests.e2e.teach_helpers import answer, next_question
 
 pytestmark = pytest.mark.e2e

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from dialog.cli import main
-from dialog.transcript import read_session
+from dialog.transcripts.jsonl import read_session
 
 pytestmark = pytest.mark.e2e
 

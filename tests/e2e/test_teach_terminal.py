@@ -3,7 +3,7 @@
 import pexpect
 import pytest
 
-from dialog.transcript import read_session
+from dialog.transcripts.jsonl import read_session
 from tests.e2e.teach_helpers import answer, next_question, spawn
 
 pytestmark = pytest.mark.e2e

@@ -12,8 +12,8 @@ from pathlib import Path
 
 import pytest
 
-from dialog.transcript import TranscriptWriter, read_session
-from dialog.transcript_lock import TranscriptLock
+from dialog.transcripts.jsonl import TranscriptWriter, read_session
+from dialog.transcripts.lock import TranscriptLock
 from learning.errors import TranscriptError
 
 pytestmark = pytest.mark.e2e
@@ -67,7 +67,7 @@ def test_two_demo_processes_on_one_transcript_lose_no_turn(tmp_path):
 
 def test_a_lock_left_by_a_killed_process_does_not_block(tmp_path):
     path = tmp_path / "t.jsonl"
-    holder = subprocess.Popen([sys.executable, "-c", "import sys, time; from dialog.transcript_lock import "
+    holder = subprocess.Popen([sys.executable, "-c", "import sys, time; from dialog.transcripts.lock import "
                                "TranscriptLock; lock = TranscriptLock(sys.argv[1]); print('held', flush=True); "
                                "time.sleep(120)", str(path)], stdout=subprocess.PIPE, text=True,
                               cwd=Path(__file__).resolve().parents[2])

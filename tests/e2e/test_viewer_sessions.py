@@ -10,8 +10,8 @@ import pytest
 
 from bullet_world.viewer import thread as viewer_thread
 from bullet_world.viewer.server import ViewerError
+from dialog import viewer as viewer_options
 from dialog.cli import main
-from dialog.commands import _viewer
 
 pytestmark = pytest.mark.e2e
 
@@ -20,7 +20,7 @@ pytestmark = pytest.mark.e2e
 def served_pages(monkeypatch):
     """Wrap the real viewer start: fetch the page while the session runs, keep (url, HTTP status, viewer)."""
     pages = []
-    real_start = _viewer.start_viewer
+    real_start = viewer_options.start_viewer
 
     def start_and_fetch(args, world):
         viewer = real_start(args, world)
@@ -29,7 +29,7 @@ def served_pages(monkeypatch):
                 pages.append((viewer.url, response.status, viewer))
         return viewer
 
-    monkeypatch.setattr(_viewer, "start_viewer", start_and_fetch)
+    monkeypatch.setattr(viewer_options, "start_viewer", start_and_fetch)
     for module in ("dialog.commands.teach", "dialog.commands.recipe"):  # imported by name there
         monkeypatch.setattr(f"{module}.start_viewer", start_and_fetch)
     return pages

@@ -21,8 +21,8 @@ pytest.importorskip("playwright.sync_api", reason="needs playwright (pip install
 
 from bullet_world.viewer.mirror import Viewer  # noqa: E402
 from bullet_world.viewer.snapshot import screenshot  # noqa: E402
-from dialog.describe import SceneDescriber  # noqa: E402
 from dialog.environment import SimulatedKitchen  # noqa: E402
+from dialog.language.describe import SceneDescriber  # noqa: E402
 
 MAGENTA, GREY = (1.0, 0.0, 1.0), (0.5, 0.5, 0.5)
 WIDTH, HEIGHT = 1000, 700

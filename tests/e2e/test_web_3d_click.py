@@ -11,7 +11,7 @@ from bullet_world.viewer.mirror import default_camera
 from bullet_world.viewer.snapshot import find_chromium
 from dialog.environment import SimulatedKitchen
 from dialog.manager import episode_generators
-from dialog.transcript import read_session
+from dialog.transcripts.jsonl import read_session
 from tests.e2e.web_helpers import WebCommand, chromium, open_page, wait_for_question
 
 pytestmark = [

@@ -12,7 +12,7 @@ import pytest
 import tornado.httpclient
 import tornado.websocket
 
-from dialog.transcript import read_session
+from dialog.transcripts.jsonl import read_session
 from dialog.web.messages import KINDS, MAX_MESSAGE_BYTES
 from tests.e2e.web_helpers import WebCommand
 

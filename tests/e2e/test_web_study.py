@@ -13,7 +13,7 @@ import pytest
 from bullet_world.viewer.snapshot import find_chromium
 from dialog.study.files import session_files
 from dialog.study.studyfile import load_study
-from dialog.transcript import read_session
+from dialog.transcripts.jsonl import read_session
 from tests.e2e.web_helpers import TEACHBOT, WebCommand, chromium, open_page
 
 pytestmark = [

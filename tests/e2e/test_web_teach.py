@@ -20,7 +20,7 @@ import pytest
 from bullet_world.viewer.snapshot import find_chromium
 from dialog.environment import SimulatedKitchen
 from dialog.manager import episode_generators
-from dialog.transcript import read_session
+from dialog.transcripts.jsonl import read_session
 from tests.e2e.web_helpers import TEACHBOT, WebCommand, chromium, comparable, open_page, send_raw, wait_for_question
 
 pytestmark = [

@@ -8,8 +8,9 @@ from pathlib import Path
 from dialog.experiments.analysis import evaluate_findings
 from dialog.experiments.features.report import feature_summaries, run_feature_suite, write_feature_report
 from dialog.experiments.features.study import METHODS
-from dialog.experiments.kinds import RunOptions, SuiteKind, SuiteRun, register_kind
+from dialog.experiments.kinds import RunOptions, SuiteKind, SuiteRun
 from dialog.experiments.pools import load_pools
+from dialog.experiments.registry import register_kind
 from dialog.experiments.runner import RenderBar
 from dialog.experiments.suite import Suite, SuiteError
 

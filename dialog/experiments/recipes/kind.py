@@ -5,7 +5,7 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
-from dialog.experiments.kinds import RunOptions, SuiteKind, SuiteRun, register_kind
+from dialog.experiments.kinds import RunOptions, SuiteKind, SuiteRun
 from dialog.experiments.recipes.report import write_recipe_report
 from dialog.experiments.recipes.suite import (
     evaluate_recipe_findings,
@@ -14,6 +14,7 @@ from dialog.experiments.recipes.suite import (
     summarise_study,
     trial_count,
 )
+from dialog.experiments.registry import register_kind
 from dialog.experiments.suite import Suite
 
 

@@ -13,7 +13,7 @@ from dialog.study.design import assigned_orders
 from dialog.study.files import session_files
 from dialog.study.studyfile import load_study
 from dialog.study.tables import refused_attempts
-from dialog.transcript import read_session
+from dialog.transcripts.jsonl import read_session
 
 EXAMPLE = Path(__file__).resolve().parents[3] / "dialog" / "data" / "studies" / "example.toml"
 PARTICIPANTS = ("P01", "P02", "P03")

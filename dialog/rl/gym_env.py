@@ -4,7 +4,7 @@ Importing this module registers the id (``pip install -e '.[rl]'`` installs
 gymnasium)::
 
     import gymnasium as gym
-    import dialog.gym_env  # registers teachbot/Questioning-v0
+    import dialog.rl.gym_env  # registers teachbot/Questioning-v0
     env = gym.make("teachbot/Questioning-v0", budget=25, turns=40)
 
 Every step is one turn of the real dialog loop that ``teachbot regress`` runs
@@ -50,7 +50,7 @@ from dialog.experiments.pools import PoolEnvironment, load_pools
 from dialog.experiments.suite import teacher_options
 from dialog.manager import DialogManager, episode_generators
 from dialog.settings import EpisodeSettings, check_costs
-from dialog.transcript import MemoryTranscript, TranscriptWriter
+from dialog.transcripts.jsonl import MemoryTranscript, TranscriptWriter
 from learning.actions import NoQuery
 from learning.decision.features import FEATURE_NAMES
 from learning.errors import SettingsError
@@ -265,4 +265,4 @@ class QuestioningEnv(gym.Env):
 
 
 if ENV_ID not in gym.registry:
-    gym.register(id=ENV_ID, entry_point="dialog.gym_env:QuestioningEnv")
+    gym.register(id=ENV_ID, entry_point="dialog.rl.gym_env:QuestioningEnv")

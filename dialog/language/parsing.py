@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from dialog.vocabulary import (
+from dialog.language.vocabulary import (
     MAX_ANSWER_CHARS,
     Token,
     Vocabulary,

@@ -12,9 +12,9 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Literal, get_args
 
-from dialog.parsing import AnswerParser, Reading
-from dialog.questions import Prompt, help_text
-from dialog.teachers import PreParsedTeacher, ReportsChannels, Teacher
+from dialog.language.parsing import AnswerParser, Reading
+from dialog.language.questions import Prompt, help_text
+from dialog.teachers.protocol import ReportsChannels, Teacher
 
 MAX_RECORDED_CHARS = 1000   # a raw line is cut to this length in the transcript
 MAX_LINES_PER_QUESTION = 200  # then the question counts as skipped (a teacher that only sends noise)
@@ -54,9 +54,7 @@ def read_line(prompt: Prompt, parser: AnswerParser, line: str) -> Reading:
 
 
 def converse(teacher: Teacher, prompt: Prompt, parser: AnswerParser, clock) -> Outcome:
-    """Ask ``prompt`` until it is answered, declined, or time runs out (``teacher`` as made by ``as_teacher``)."""
-    if isinstance(teacher, PreParsedTeacher):
-        return teacher.outcome(prompt)
+    """Ask ``prompt`` until it is answered, declined, or time runs out."""
     started = clock.now()
     teacher.show(prompt)
     lines: list[str] = []

@@ -17,7 +17,7 @@ from bullet_world.viewpoint import Viewpoint
 from learning.datafiles import check_keys, number, read_toml, tables, text
 from learning.errors import DataFileError
 
-COLOURS_FILE = Path(__file__).parent / "data" / "colours.toml"
+COLOURS_FILE = Path(__file__).parents[1] / "data" / "colours.toml"
 SIZE_FEATURES = {"length": ("size.length", "bbox.length", "length"), "width": ("size.width", "bbox.width", "width"),
                  "height": ("size.height", "bbox.height", "height")}
 ROUND_ASPECT = 1.2      # length / width at most this: round (or square) from above

@@ -8,9 +8,9 @@ record that does not repeat raises a :class:`TranscriptError` naming the turn.
 
 from __future__ import annotations
 
-from dialog import records as checks
-from dialog.records import action_from_record, outcome_from_record
-from dialog.teachers import FastForwards
+from dialog.teachers.protocol import FastForwards
+from dialog.transcripts import records as checks
+from dialog.transcripts.records import action_from_record, outcome_from_record
 from learning.errors import TranscriptError
 
 

@@ -1,112 +1,24 @@
-"""Teachers answer the robot's questions, all behind one small interface.
-
-A teacher is shown a :class:`~dialog.questions.Prompt`, answers with one line
-of text at a time (``listen``; None means no more input, or no answer before
-the deadline), and hears the robot's replies (``tell``). The same parser reads
-every teacher's lines, so scripted runs exercise what a person would type.
+"""The simulated teachers: scripted (seeded imperfections), oracle, replay (the interface: dialog.teachers.protocol).
 
 - :class:`ScriptedTeacher`: an oracle from the hidden ground truth, with a
   mislabel rate, a "don't know" rate, a feature-answer quality and an answer
   delay, all drawn from one seeded generator.
 - :class:`ReplayTeacher`: the lines of a recorded transcript, turn by turn.
-- ``dialog.terminal.TerminalTeacher``: a person at the terminal.
+- ``dialog.teachers.terminal.TerminalTeacher``: a person at the terminal.
 
-Every teacher is a :class:`Teacher` (``show``, ``listen``, ``tell``); one that
-can skip answers on resume is also :class:`FastForwards`. Older teachers with
-``answer(action, question, scene) -> Answer`` (value already parsed) go behind
-:class:`PreParsedTeacher` (:func:`as_teacher`), whose values are used as given.
+Every teacher is a :class:`~dialog.teachers.protocol.Teacher` (``show``, ``listen``, ``tell``); one that
+can skip answers on resume is also :class:`~dialog.teachers.protocol.FastForwards`.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import Protocol, runtime_checkable
-
 import numpy as np
 
 from dialog.clock import VirtualClock
-from dialog.questions import Prompt, article
+from dialog.language.questions import Prompt, article
 from learning.errors import SettingsError
 
 DELAY_SHAPE = 4.0  # answer delays are gamma-distributed with this shape around the mean
-
-
-@dataclass(frozen=True)
-class Answer:
-    """A pre-parsed answer from an older-style teacher: ``raw`` text and its ``value`` (None = none)."""
-
-    raw: str
-    value: object = None
-
-
-@runtime_checkable
-class Teacher(Protocol):
-    """The one teacher interface: shown a prompt, answers one line at a time, hears the robot's replies."""
-
-    def show(self, prompt: Prompt) -> None: ...
-
-    def listen(self, prompt: Prompt, deadline: float | None) -> str | None: ...
-
-    def tell(self, text: str) -> None: ...
-
-
-@runtime_checkable
-class FastForwards(Protocol):
-    """A teacher whose answers come from a seeded stream: on resume it skips the answers already recorded."""
-
-    def fast_forward(self, prompt: Prompt) -> None: ...
-
-
-@runtime_checkable
-class ReportsChannels(Protocol):
-    """A teacher whose lines come by different ways (the page: click, button, typed): after each ``listen``,
-    ``answer_channel()`` says how that line came, ``{"channel": ..., "page_seconds": ...}``."""
-
-    def answer_channel(self) -> dict: ...
-
-
-@runtime_checkable
-class AnswersParsed(Protocol):
-    """An older-style teacher that answers with a parsed value."""
-
-    def answer(self, action, question: str, scene) -> Answer: ...
-
-
-class PreParsedTeacher:
-    """An :class:`AnswersParsed` teacher behind the :class:`Teacher` interface; ``outcome`` gives its parsed
-    value as the question's outcome, without the parser."""
-
-    def __init__(self, inner: AnswersParsed):
-        self.inner = inner
-
-    def show(self, prompt: Prompt) -> None:
-        pass
-
-    def listen(self, prompt: Prompt, deadline: float | None) -> str | None:
-        return str(self.inner.answer(prompt.action, prompt.text, prompt.scene).raw)
-
-    def tell(self, text: str) -> None:
-        pass
-
-    def outcome(self, prompt: Prompt):
-        from dialog.conversation import Outcome  # here: the conversation imports this module
-
-        answer = self.inner.answer(prompt.action, prompt.text, prompt.scene)
-        value = answer.value
-        if prompt.expects == "feature" and value is not None:
-            value = tuple(int(v) for v in value)
-        kind = "answer" if value is not None else ("absent" if prompt.expects == "demo" else "skip")
-        return Outcome(kind, value, [str(answer.raw)])
-
-
-def as_teacher(teacher) -> Teacher:
-    """``teacher`` itself when it is a :class:`Teacher`; an older :class:`AnswersParsed` one wrapped."""
-    if isinstance(teacher, Teacher):
-        return teacher
-    if isinstance(teacher, AnswersParsed):
-        return PreParsedTeacher(teacher)
-    raise TypeError(f"{type(teacher).__name__} is not a teacher: it needs show, listen and tell "
-                    "(or an older-style answer(action, question, scene))")
 
 
 def relevant_feature_indices(prompt: Prompt) -> list[int]:
@@ -270,41 +182,6 @@ class ReplayTeacher:
         return pending.pop(0) if pending else None
 
 
-TEACHER_KINDS = ("terminal", "scripted", "oracle", "replay")
 # the feature answer's quality model (ScriptedTeacher): its defaults are the exact answer
 FEATURE_MODEL_EXACT = {"feature_recall": 1.0, "feature_noise": 0.0, "feature_dont_know_rate": 0.0}
 SCRIPTED_OPTIONS = ("mislabel_rate", "dont_know_rate", "feature_quality", "answer_delay", *FEATURE_MODEL_EXACT)
-
-
-def make_teacher(kind: str, *, rng: np.random.Generator | None = None, clock=None, transcript=None,
-                 input_stream=None, output_stream=None, answer_delays: dict | None = None, **options) -> Teacher:
-    """The one teacher factory, for teach sessions, expert episodes and suites.
-
-    ``terminal``: a person (``input_stream``/``output_stream``, the terminal by default); ``scripted``: an
-    oracle with ``SCRIPTED_OPTIONS`` drawn from ``rng``; ``oracle``: a perfect one; ``replay``: the lines of the
-    ``transcript`` file. An unknown kind or option is a :class:`SettingsError` naming what is accepted.
-    ``answer_delays`` (embodied costs): a scripted or oracle teacher's mean answer seconds per query kind.
-    """
-    if kind not in TEACHER_KINDS:
-        raise SettingsError(f"teacher '{kind}' is not one of {', '.join(TEACHER_KINDS)}")
-    accepted = SCRIPTED_OPTIONS if kind == "scripted" else ()
-    unknown = sorted(set(options) - set(accepted))
-    if unknown:
-        raise SettingsError(f"a {kind} teacher does not take the options {', '.join(unknown)}; accepted: "
-                            f"{', '.join(accepted) or 'none'}")
-    if kind == "terminal":
-        from dialog.terminal import TerminalTeacher  # here: the terminal imports the questions this module uses
-
-        return TerminalTeacher(input_stream, output_stream, clock=clock)
-    if kind == "replay":
-        if not transcript:
-            raise SettingsError("a replay teacher needs the transcript to replay (--replay FILE)")
-        from dialog.transcript import read_session
-
-        return ReplayTeacher(read_session(transcript)[1])
-    if rng is None:
-        raise TypeError(f"a {kind} teacher needs its random generator (rng=)")
-    if kind == "oracle":
-        return OracleTeacher(rng, clock=clock, answer_delays=answer_delays)
-    return ScriptedTeacher(rng, clock=clock, answer_delays=answer_delays,
-                           **{name: float(value) for name, value in options.items()})

@@ -15,8 +15,16 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, field
 
-from dialog.parsing import Reading
-from dialog.vocabulary import MAX_ANSWER_CHARS, Vocabulary, clean, load_vocabulary, phrase, refused_characters, word_key
+from dialog.language.parsing import Reading
+from dialog.language.vocabulary import (
+    MAX_ANSWER_CHARS,
+    Vocabulary,
+    clean,
+    load_vocabulary,
+    phrase,
+    refused_characters,
+    word_key,
+)
 
 _NUMBER = re.compile(r"^\d{1,3}(\.\d{1,3})*$")
 _PLAIN_WORDS = ("feature", "features", "group", "groups")

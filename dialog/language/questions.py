@@ -6,9 +6,9 @@ import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from dialog.describe import SceneDescriber
 from dialog.environment import KnowsRelevantFeatures, SupportsLocations, SupportsPictures, SupportsViewpoint
-from dialog.feature_tree import FeatureTree
+from dialog.language.describe import SceneDescriber
+from dialog.language.feature_tree import FeatureTree
 from learning.actions import Action
 from learning.errors import OutputPathError
 

@@ -4,8 +4,8 @@ The one loop stays ``DialogManager``: ``ExpertStrategy`` is an ordinary
 strategy whose ``choose`` computes every candidate action and its expected
 decision features exactly as the DT strategy does at run time
 (``learning.decision.candidates.expected_decision_features`` with the same what-if engine
-and window), hands them to a *chooser* (``dialog.expert_terminal.PersonChooser``
-or ``dialog.scripted_expert.ScriptedExpertChooser``, the rules of the ``scripted-expert``
+and window), hands them to a *chooser* (``dialog.expert.terminal.PersonChooser``
+or ``dialog.expert.scripted.ScriptedExpertChooser``, the rules of the ``scripted-expert``
 strategy), and records the turn as
 an IRL ``DecisionTurn`` (Phi of every candidate, the chosen row). A scripted
 teacher answers through the manager as in any episode. A chooser ends the
@@ -28,8 +28,8 @@ import numpy as np
 from dialog.clock import VirtualClock
 from dialog.manager import DialogManager, EpisodeResult, episode_generators
 from dialog.settings import EpisodeSettings
-from dialog.teachers import ScriptedTeacher
-from dialog.transcript import TranscriptWriter
+from dialog.teachers.scripted import ScriptedTeacher
+from dialog.transcripts.jsonl import TranscriptWriter
 from learning.actions import Action, Decision
 from learning.decision.candidates import CandidateFeatures, expected_decision_features
 from learning.decision.habits import EXTENDED_FEATURE_NAMES

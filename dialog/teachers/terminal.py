@@ -16,7 +16,7 @@ import sys
 
 from rich.console import Console
 
-from dialog.questions import Prompt
+from dialog.language.questions import Prompt
 
 MAX_LINE_BYTES = 4 << 20  # a longer "line" is handed over as it is, the rest read as the next line
 TIMEOUT = object()

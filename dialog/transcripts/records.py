@@ -14,9 +14,9 @@ import math
 
 import numpy as np
 
-from dialog.conversation import Outcome
-from dialog.describe import OLD_WORLD_VIEWPOINT, SceneDescriber
-from dialog.questions import question_text
+from dialog.language.describe import OLD_WORLD_VIEWPOINT, SceneDescriber
+from dialog.language.questions import question_text
+from dialog.teachers.conversation import Outcome
 from learning.actions import Action, DemoQuery, FeatureQuery, LabelQuery, NoQuery
 from learning.errors import TranscriptError
 

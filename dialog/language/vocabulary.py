@@ -11,7 +11,7 @@ from pathlib import Path
 from learning.datafiles import MissingDataFileError, check_keys, read_toml, section
 from learning.errors import DataFileError
 
-VOCABULARY_FILE = Path(__file__).parent / "data" / "vocabulary.toml"
+VOCABULARY_FILE = Path(__file__).parents[1] / "data" / "vocabulary.toml"
 MAX_ANSWER_CHARS = 300  # longer answers are refused before any matching is tried
 COMMANDS = ("help", "why", "undo", "skip", "quit", "dont_know")
 _SPLIT = re.compile(r"[^\w'#]+")

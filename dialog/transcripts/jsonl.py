@@ -13,7 +13,7 @@ import os
 from pathlib import Path
 
 from dialog.output_paths import writing
-from dialog.transcript_lock import TranscriptLock
+from dialog.transcripts.lock import TranscriptLock
 from learning.errors import OutputPathError, TranscriptError
 
 FORMAT = "teachbot-transcript"

@@ -2,13 +2,13 @@
 
 The rules live in one place, ``learning.strategies.scripted_expert`` (the strategy
 ``scripted-expert``; its numbers in learning/strategies/data/scripted-expert.toml); this
-chooser hands them the view ``dialog.expert.ExpertStrategy`` builds, so an expert-mode episode
+chooser hands them the view ``dialog.expert.episode.ExpertStrategy`` builds, so an expert-mode episode
 and a ``scripted-expert`` episode with the same seed ask the same questions.
 """
 
 from __future__ import annotations
 
-from dialog.expert import ExpertView
+from dialog.expert.episode import ExpertView
 from learning.actions import Action
 from learning.strategies.scripted_expert import RULES_FILE, ExpertPlan, ExpertRules, paced_budget
 

@@ -12,9 +12,9 @@ import sys
 from rich.console import Console
 from rich.table import Table
 
-from dialog.describe import SceneDescriber
-from dialog.expert import ExpertQuit, ExpertView, action_label
-from dialog.terminal import LineReader
+from dialog.expert.episode import ExpertQuit, ExpertView, action_label
+from dialog.language.describe import SceneDescriber
+from dialog.teachers.terminal import LineReader
 from learning.actions import Action, DemoQuery, FeatureQuery, LabelQuery, NoQuery
 from learning.decision.features import label_distribution
 

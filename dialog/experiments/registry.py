@@ -1,0 +1,46 @@
+"""The registry of suite kinds, by name: filled by ``register_kind``, the built-in kinds loaded when first asked for.
+
+It imports no suite kind itself, so that the suite file reader (``dialog.experiments.suite``) can check a
+suite's ``kind`` against it while every kind module imports that reader.
+"""
+
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from dialog.experiments.kinds import SuiteKind
+
+BUILTIN_KIND_MODULES = ("dialog.experiments.episode_kind", "dialog.experiments.features.kind",
+                        "dialog.experiments.recipes.kind")
+
+_KINDS: dict[str, SuiteKind] = {}  # name -> the registered kind, built-in ones first
+
+
+def register_kind(kind: type[SuiteKind]) -> type[SuiteKind]:
+    """Register a ``SuiteKind`` subclass under its ``name`` (usable as a class decorator)."""
+    name = getattr(kind, "name", "")
+    if not isinstance(name, str) or not name:
+        raise TypeError(f"{kind.__name__} needs a non-empty class attribute 'name'")
+    if name in _KINDS and type(_KINDS[name]) is not kind:
+        raise ValueError(f"a suite kind named '{name}' is already registered ({type(_KINDS[name]).__name__})")
+    _KINDS[name] = kind()
+    return kind
+
+
+def _load_builtin_kinds() -> None:
+    for module in BUILTIN_KIND_MODULES:
+        importlib.import_module(module)
+
+
+def kind_names() -> tuple[str, ...]:
+    """The registered kinds, built-in ones first."""
+    _load_builtin_kinds()
+    return tuple(_KINDS)
+
+
+def registered() -> dict[str, SuiteKind]:
+    """The registered kinds by name (the built-in ones loaded first)."""
+    _load_builtin_kinds()
+    return _KINDS

@@ -1,0 +1,1 @@
+"""What the robot says and reads: the answer grammar, vocabulary, feature tree, questions, descriptions, pictures."""

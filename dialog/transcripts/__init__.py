@@ -1,0 +1,1 @@
+"""What is recorded: JSON Lines transcripts and their lock, turns as records and back, resuming by replay."""
