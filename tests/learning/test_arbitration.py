@@ -20,7 +20,8 @@ TASK = SyntheticTask(n_features=10, n_informative=3, seed=1)
 
 def test_every_strategy_name_is_registered():
     assert STRATEGY_NAMES == ("passive", "active", "random", "hfs-passive", "hfs-active", "all-cd", "dt", "dt-iros",
-                              "dt-task", "dt-task-env", "scripted-expert", "passive-fs", "active-fs")
+                              "dt-task", "dt-task-env", "dt-task-env-thesis", "dt-task-env-no-env", "dt-task-habits",
+                              "scripted-expert", "passive-fs", "active-fs")
     for name in STRATEGY_NAMES:
         assert make_strategy(name).name == name
 
@@ -99,7 +100,7 @@ def test_dt_chooses_what_its_expected_features_say():
     state = random_state(TASK, 10, 5, np.random.default_rng(5))
     strategy = make_strategy("dt-task-env")
     decision = strategy.choose(state, np.random.default_rng(0))
-    candidates = expected_decision_features(state)
+    candidates = expected_decision_features(state, habits=True)  # dt-task-env weighs the expert-habit features too
     expected_choice = candidates.actions[choose_index(candidates.utilities(preset_weights("dt-task-env")))]
     assert decision.action == expected_choice
     np.testing.assert_allclose(strategy.last_candidates.expected, candidates.expected)
@@ -123,9 +124,13 @@ def test_dt_asks_a_costly_query_only_when_it_pays():
 
 
 def test_weight_presets_load_and_bad_weights_are_explained(tmp_path):
+    from learning.decision.habits import EXTENDED_FEATURE_NAMES
+
     for name in PRESETS:
         weights = preset_weights(name)
-        assert weights.shape == (len(FEATURE_NAMES),) and np.all(np.isfinite(weights))
+        assert weights.shape in ((len(FEATURE_NAMES),), (len(EXTENDED_FEATURE_NAMES),)) and np.all(np.isfinite(weights))
+    assert preset_weights("dt-task-env").shape == (len(EXTENDED_FEATURE_NAMES),)
+    assert preset_weights("dt-task-env-thesis").shape == (len(FEATURE_NAMES),)  # the thesis's seven, unchanged
     assert np.count_nonzero(preset_weights("dt-iros")[2:]) == 0
     assert np.count_nonzero(preset_weights("dt-task")[4:]) == 0
     np.testing.assert_allclose(resolve_weights({"instance_variation": 2.0}), [0, 0, 2, 0, 0, 0, 0])

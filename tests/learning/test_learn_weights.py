@@ -15,36 +15,49 @@ LEARNED = WEIGHTS_DIRECTORY / "dt-task-env.toml"  # the dt-task-env preset carri
 
 
 def test_learn_weights_per_turn_on_the_shipped_demos_prints_the_summary(tmp_path, capsys):
-    """The per-turn fit (--method per-turn); it reproduces the shipped file when that was learned per turn."""
+    """The per-turn fit (--method per-turn) on the shipped demonstrations, which record the eleven features."""
+    from learning.decision.habits import EXTENDED_FEATURE_NAMES
+
     out = tmp_path / "w.toml"
-    assert main(["learn-weights", "--demos", "shipped", "--out", str(out), "--method", "per-turn", "--json"]) == 2
-    error = capsys.readouterr().err  # issue 23 case 2 / issue 27 item 2: a fit that can never ask is refused
-    assert "nothing written" in error and "can never ask" in error and "--allow-degenerate" in error
-    assert "cannot identify remaining_time" in error and not out.exists()
-    assert main(["learn-weights", "--demos", "shipped", "--out", str(out), "--method", "per-turn", "--json",
-                 "--allow-degenerate"]) == 0
+    assert main(["learn-weights", "--demos", "shipped", "--out", str(out), "--method", "per-turn", "--json"]) == 0
     captured = capsys.readouterr()
-    assert sum("never asks" in line for line in captured.err.splitlines()) == 1  # written, and warned about
+    assert "cannot identify remaining_time" in captured.err  # named, and left at 0
     summary = json.loads(captured.out.strip().splitlines()[-1])
     assert set(summary) == {"iterations", "seconds", "weights", "validation_agreement"}
     assert 0.0 <= summary["validation_agreement"] <= 1.0 and 1 <= summary["iterations"] <= 100
-    assert list(summary["weights"]) == list(FEATURE_NAMES)
-    np.testing.assert_array_equal(load_weight_file(out), [summary["weights"][n] for n in FEATURE_NAMES])
-    provenance = load_weights(LEARNED, FEATURE_NAMES).provenance
-    learned_from = {name for key in ("train_episodes", "validation_episodes")
-                    for name in provenance.get(key, "").split(", ") if name}
-    shipped = {path.stem for path in SHIPPED_DEMOS.glob("*.json")}
-    if provenance.get("method") == "maxent-irl" and learned_from == shipped:  # learned per turn from these files
-        np.testing.assert_array_equal(load_weight_file(out), load_weight_file(LEARNED))  # the shipped file, reproduced
+    assert list(summary["weights"]) == list(EXTENDED_FEATURE_NAMES) and summary["weights"]["remaining_time"] == 0.0
+    np.testing.assert_array_equal(load_weight_file(out), [summary["weights"][n] for n in EXTENDED_FEATURE_NAMES])
+
+
+def test_a_fit_that_can_never_ask_is_refused_unless_allowed(tmp_path, capsys):
+    """Issue 23 case 2 / issue 27 item 2: the seven features alone on demonstrations whose asks they cannot tell
+    apart give all-zero weights with a zero start; --allow-degenerate writes them, with a warning."""
+    demos = tmp_path / "demos"
+    demos.mkdir()
+    from learning.irl.demonstrations import DecisionTurn, QuestioningEpisode, save_episodes
+
+    phi = np.zeros((3, len(FEATURE_NAMES)))
+    turns = tuple(DecisionTurn(phi, t % 3, ("label", "label", "none")) for t in range(6))
+    for i in range(3):
+        save_episodes(demos / f"flat{i}.json", [QuestioningEpisode(FEATURE_NAMES, turns, f"flat{i}", {})])
+    out = tmp_path / "w.toml"
+    assert main(["learn-weights", "--demos", str(demos), "--out", str(out), "--method", "per-turn"]) == 2
+    error = capsys.readouterr().err
+    assert "nothing written" in error and "can never ask" in error and "--allow-degenerate" in error
+    assert not out.exists()
+    assert main(["learn-weights", "--demos", str(demos), "--out", str(out), "--method", "per-turn",
+                 "--allow-degenerate"]) == 0
+    assert sum("never asks" in line for line in capsys.readouterr().err.splitlines()) == 1 and out.exists()
 
 
 def test_the_shipped_learned_weights_say_where_they_came_from():
-    provenance = load_weights(LEARNED, FEATURE_NAMES).provenance
-    assert provenance["method"] in ("maxent-irl", "maxent-irl-trajectory") and provenance["demos"] == "shipped"
-    held_out = provenance.get("held_out_turns", provenance.get("validation_turns", 0))
-    assert len(provenance["train_episodes"].split(", ")) == 3 and held_out > 0
-    if provenance["method"] == "maxent-irl-trajectory":  # the thesis's fit: where and how it was kept
-        assert {"commit", "data_seed", "validation_seeds", "validation_accuracy", "best_iteration"} <= set(provenance)
+    from learning.decision.habits import EXTENDED_FEATURE_NAMES
+
+    provenance = load_weights(LEARNED, EXTENDED_FEATURE_NAMES).provenance
+    assert provenance["method"] == "maxent-irl-per-turn-imitation" and provenance["demos"] == "shipped"
+    assert {"commit", "data_seed", "split_seeds", "fit_seeds", "kept_split_seed", "kept_fit_seed",
+            "held_out_exact_agreement", "validation_log_likelihood", "ship_rule"} <= set(provenance)
+    assert len(provenance["held_out_episodes"].split(", ")) == 10
 
 
 def test_bad_demonstrations_get_one_clear_message(tmp_path, capsys):
