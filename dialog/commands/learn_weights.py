@@ -2,7 +2,8 @@
 
 ``--method imitation`` (default, issue 27): per-turn MaxEnt fits over three-way splits of the demonstrations and
 random starts, each iterate kept by validation log-likelihood, judged by held-out imitation; the fit shipped is the
-one a rule fixed in advance picks (learning.irl.imitation). ``--method trajectory``: the thesis's trajectory-level fit (eq. 7.7), the learner's feature counts from
+one a rule fixed in advance picks (learning.irl.imitation).
+``--method trajectory``: the thesis's trajectory-level fit (eq. 7.7), the learner's feature counts from
 rollouts of the real dialog loop in the training condition (dialog.experiments.irl_rollouts), the iterate kept by
 the final accuracy of greedy episodes on validation seeds. ``--method per-turn``: the per-turn fits of
 learning.irl.maxent, kept by agreement with held-out demonstrations.
@@ -71,7 +72,8 @@ def register(commands) -> None:
                             help="play the rollouts on the Ray cluster at ADDRESS ('local' starts one here)")
     imitation = parser.add_argument_group("imitation fit (--method imitation)")
     imitation.add_argument("--split-seeds", type=seed, nargs="+", default=[0, 1, 2], metavar="N",
-                           help="each seed splits the demonstrations into train / validation / held out (default 0 1 2)")
+                           help="each seed splits the demonstrations into train / validation / held out "
+                                "(default 0 1 2)")
     imitation.add_argument("--fit-seeds", type=seed, nargs="+", default=[0, 1, 2, 3, 4], metavar="N",
                            help="each seed draws a random start for every split (default 0 1 2 3 4)")
     imitation.add_argument("--report", type=file_argument, default=None, metavar="FILE.json",
@@ -111,7 +113,8 @@ def run(args: argparse.Namespace, output_stream=None) -> int:
     fitted = UserWeights(str(args.out), tuple(learned.weights.as_dict().items()))
     if fitted.never_asks() and not getattr(args, "allow_degenerate", False):
         raise SettingsError(f"--out {args.out}: nothing written: the fit kept iteration "
-                            f"{learned.weights.provenance.get('best_iteration')}, whose weights can never ask (every weight but "
+                            f"{learned.weights.provenance.get('best_iteration')}, whose weights can never ask "
+                            "(every weight but "
                             "remaining_time's is 0, so every turn ties with no query); fit with other options "
                             "(e.g. --method trajectory, more "
                             "--iterations), or write them anyway with --allow-degenerate")

@@ -30,7 +30,6 @@ import numpy as np
 
 from learning.actions import Action, DemoQuery, FeatureQuery, LabelQuery, NoQuery
 from learning.decision.embodied import absent_chance
-from learning.decision.habits import EXTENDED_FEATURE_NAMES, expected_habits
 from learning.decision.features import (
     FEATURE_NAMES,
     concept_counts,
@@ -39,6 +38,7 @@ from learning.decision.features import (
     learning_features,
     state_clock,
 )
+from learning.decision.habits import EXTENDED_FEATURE_NAMES, expected_habits
 from learning.whatif import WhatIfEngine, make_engine
 
 

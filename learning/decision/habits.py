@@ -88,7 +88,7 @@ def expected_habits(state, actions, outcomes, P: np.ndarray, counts: np.ndarray,
     unsure_quiet = unsure_unlabelled(unsure_objects(P), labelled_now)
     concept_index = {c: k for k, c in enumerate(state.concepts)}
     rows = np.empty((len(actions), len(HABIT_FEATURES)))
-    demo_unsure = None
+    demo_unsure = np.zeros((n_concepts, n_objects))  # replaced whenever a query was simulated
     if outcomes is not None and n_objects:
         shown = labelled_now[None, :] | np.eye(n_objects, dtype=bool)  # row x: the shown object x labelled too
         demo_unsure = unsure_unlabelled(unsure_objects(outcomes.demo), shown[None, :, :])  # (|Y|, |X|)

@@ -28,8 +28,9 @@ from learning.errors import SettingsError, did_you_mean
 from learning.limits import check_limit
 
 WEIGHTS_DIRECTORY = Path(__file__).resolve().parent / "presets"
-# dt-task-env weighs the seven and the expert-habit features (issue 27); dt-task-env-thesis is the thesis's seven-feature
-# DT-task-env (the earlier trajectory fit); the last two are issue 27's pre-registered ablations (docs/irl.md).
+# dt-task-env weighs the seven and the expert-habit features (issue 27); dt-task-env-thesis is the thesis's
+# seven-feature DT-task-env (the earlier trajectory fit); the last two are issue 27's pre-registered ablations
+# (docs/irl.md).
 PRESETS = ("dt", "dt-iros", "dt-task", "dt-task-env", "dt-task-env-thesis", "dt-task-env-no-env", "dt-task-habits")
 
 

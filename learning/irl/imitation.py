@@ -51,8 +51,9 @@ def _choice_turns(episodes: Sequence[QuestioningEpisode]) -> list[DecisionTurn]:
 
 def imitation_scores(episodes: Sequence[QuestioningEpisode], weights: np.ndarray, policy: str = "softmax") -> dict:
     """The four scores of the module docstring over the turns with a choice, and how many turns they are."""
-    from learning.irl.maxent import PaddedTurns, _TorchTurns  # torch: only when scoring a fit
     import torch
+
+    from learning.irl.maxent import PaddedTurns, _TorchTurns  # torch: only when scoring a fit
 
     turns = _choice_turns(episodes)
     weights = np.asarray(weights, dtype=np.float64)
@@ -112,7 +113,7 @@ class ProtocolFit:
     split_seed: int
     fit_seed: int
     policy: str
-    weights: object  # learning.decision.weights_file.DecisionWeights
+    weights: DecisionWeights
     train: tuple[str, ...]
     validation: tuple[str, ...]
     held_out: tuple[str, ...]

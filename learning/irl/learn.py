@@ -109,7 +109,8 @@ class LearnedWeights:
 
 
 def learn_weights(demos: str | Path, iterations: int = 100, seed: int = 0,
-                  n_validation: int | None = None, policy: str = "gated", features: str | None = None) -> LearnedWeights:
+                  n_validation: int | None = None, policy: str = "gated",
+                  features: str | None = None) -> LearnedWeights:
     """Load, split (seeded), fit and package the weights with a [provenance] table (method maxent-irl).
 
     ``policy="gated"`` (default) fits the DT's own ask-or-not-then-which rule; ``"softmax"`` the plain
@@ -238,7 +239,8 @@ def learn_imitation_weights(demos: str | Path, split_seeds=(0, 1, 2), fit_seeds=
         seven_fits = fit_protocol(select_features(episodes, FEATURE_NAMES), split_seeds, fit_seeds,
                                   iterations=iterations)
         seven_kept = shipped_fit(seven_fits)
-        seven = {"policy": seven_kept.policy, "held_out": spread([f for f in seven_fits if f.policy == seven_kept.policy]),
+        same_form = [f for f in seven_fits if f.policy == seven_kept.policy]
+        seven = {"policy": seven_kept.policy, "held_out": spread(same_form),
                  "kept_held_out": seven_kept.held_out_scores}
     report = {"features": list(episodes[0].feature_names), "policy": kept.policy,
               "kept": {"split_seed": kept.split_seed, "fit_seed": kept.fit_seed, "best_iteration": kept.best_iteration,

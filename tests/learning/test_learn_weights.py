@@ -9,7 +9,6 @@ from dialog.cli import main
 from learning.decision.features import FEATURE_NAMES
 from learning.decision.weights import WEIGHTS_DIRECTORY, load_weight_file
 from learning.decision.weights_file import load_weights
-from learning.irl.learn import SHIPPED_DEMOS
 
 LEARNED = WEIGHTS_DIRECTORY / "dt-task-env.toml"  # the dt-task-env preset carries the learned weights
 
