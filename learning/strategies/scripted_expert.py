@@ -28,7 +28,7 @@ the scene changes. ``ExpertPlan`` follows these rules, in order, each turn
 It reads only the learner's state and the turn's candidates (the robot's
 perception and beliefs), never the hidden scene truth or the test set, so its
 choices are ones the decision features can in principle explain. Every random
-choice uses the strategy's generator. ``dialog.scripted_expert`` puts the same
+choice uses the strategy's generator. ``dialog.expert.scripted`` puts the same
 plan behind ``teachbot expert --expert scripted``.
 """
 
