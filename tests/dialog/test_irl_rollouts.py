@@ -20,6 +20,7 @@ from dialog.experiments.irl_rollouts import (
 )
 from dialog.experiments.suite import Condition
 from learning.decision.features import FEATURE_NAMES
+from learning.decision.habits import EXTENDED_FEATURE_NAMES
 from learning.decision.weights_file import load_weights
 from learning.errors import SettingsError
 
@@ -92,11 +93,12 @@ def test_ray_absent_or_bad_worker_counts_get_one_line(monkeypatch):
 @pytest.mark.e2e
 def test_learn_weights_by_trajectory_on_the_real_loop_writes_weights_with_provenance(tmp_path, capsys):
     out = tmp_path / "w.toml"
-    assert main(["learn-weights", "--demos", "shipped", "--out", str(out), "--iterations", "2", "--rollouts", "2",
+    assert main(["learn-weights", "--demos", "shipped", "--out", str(out), "--method", "trajectory",
+                 "--iterations", "2", "--rollouts", "2",
                  "--validation-episodes", "2", "--evaluate-every", "1", "--workers", "2", "--json"]) == 0
     printed = capsys.readouterr().out
     assert "iteration   2/2" in printed and "total" in printed and "validation accuracy" in printed
-    weights = load_weights(out, FEATURE_NAMES)
+    weights = load_weights(out, EXTENDED_FEATURE_NAMES)  # the shipped demonstrations record the habits too
     p = weights.provenance
     assert p["method"] == "maxent-irl-trajectory" and p["iterations"] == 2 and 0 <= p["best_iteration"] <= 2
     assert p["data_seed"] == training_condition().data_seed and p["budget"] == 15.0 and p["turns"] == 30
@@ -111,11 +113,15 @@ def test_learn_weights_by_trajectory_on_the_real_loop_writes_weights_with_proven
 
 def test_options_of_the_other_method_are_refused(tmp_path, capsys):
     out = str(tmp_path / "w.toml")
-    assert main(["learn-weights", "--demos", "shipped", "--out", out, "--policy", "softmax"]) == 2
+    assert main(["learn-weights", "--demos", "shipped", "--out", out, "--method", "trajectory", "--policy",
+                 "softmax"]) == 2
     assert "--policy do(es) not apply to --method trajectory" in capsys.readouterr().err
+    assert main(["learn-weights", "--demos", "shipped", "--out", out, "--workers", "2"]) == 2
+    assert "--workers do(es) not apply to --method imitation" in capsys.readouterr().err  # the default method
     assert main(["learn-weights", "--demos", "shipped", "--out", out, "--method", "per-turn", "--ray", "local"]) == 2
     assert "--ray do(es) not apply to --method per-turn" in capsys.readouterr().err
     assert main(["learn-weights", "--demos", "shipped", "--out", out, "--method", "per-turn", "--start", "zero"]) == 2
     assert "--start do(es) not apply to --method per-turn" in capsys.readouterr().err
-    assert main(["learn-weights", "--demos", "shipped", "--out", out, "--train-episodes", "999"]) == 2
+    assert main(["learn-weights", "--demos", "shipped", "--out", out, "--method", "trajectory",
+                 "--train-episodes", "999"]) == 2
     assert "--train-episodes must be in 1.." in capsys.readouterr().err  # before any rollout is played

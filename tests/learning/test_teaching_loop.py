@@ -79,7 +79,9 @@ def test_every_strategy_learns_iris_with_an_oracle(strategy):
     spent = sum(turn.query.cost for turn in loop.history)
     assert spent == pytest.approx(16 - loop.budget_left)
     assert loop.predict(X_IRIS).dtype.kind == "i"  # the caller's labels come back
-    if any(turn.change.kind == "example" for turn in loop.history):
+    # The issue-27 ablation without the environment features asks once and then stays quiet on iris (it is a
+    # diagnostic of where dt-task-env's wins come from, not a questioner we claim learns); the rest must learn.
+    if strategy != "dt-task-env-no-env" and any(turn.change.kind == "example" for turn in loop.history):
         assert np.mean(loop.predict(X_IRIS) == Y_IRIS) > 0.5
     assert np.allclose(loop.classifier.predict_proba(X_IRIS), loop.predict_proba(X_IRIS))
 
