@@ -63,6 +63,10 @@ def register(commands) -> None:
                                  f"{VALIDATION_EPISODES})")
     trajectory.add_argument("--evaluate-every", type=positive_int, default=EVALUATE_EVERY, metavar="K",
                             help=f"score every K-th iterate and the last (default {EVALUATE_EVERY})")
+    trajectory.add_argument("--select", choices=("likelihood", "accuracy"), default="likelihood",
+                            help="keep the iterate with the best log-likelihood of the held-out demonstrations' "
+                                 "choices (default; the IRL objective), or the best task accuracy of greedy episodes "
+                                 "on the validation seeds (scored every --evaluate-every iterations)")
     trajectory.add_argument("--start", choices=("per-turn", "zero"), default="per-turn",
                             help="iteration 0: the per-turn MaxEnt fit of the training demonstrations (default), or "
                                  "w = 0 (the default before issue 15; the shipped dt-task-env weights)")
@@ -147,6 +151,7 @@ def check_options(args: argparse.Namespace, method: str) -> None:
     """Options of the other method are refused rather than silently ignored."""
     trajectory_only = [("--ray", getattr(args, "ray", None) is not None),
                        ("--start", getattr(args, "start", "per-turn") != "per-turn"),
+                       ("--select", getattr(args, "select", "likelihood") != "likelihood"),
                        ("--workers", getattr(args, "workers", None) is not None)]
     imitation_only = [("--split-seeds", getattr(args, "split_seeds", [0, 1, 2]) != [0, 1, 2]),
                       ("--fit-seeds", getattr(args, "fit_seeds", [0, 1, 2, 3, 4]) != [0, 1, 2, 3, 4]),
@@ -228,7 +233,8 @@ def learn_trajectory(args: argparse.Namespace, out):
     condition = training_condition()
     held_out = validation_seeds(args.validation_episodes)
     config = FeatureMatchingConfig(max_iterations=args.iterations, rollouts_per_iteration=args.rollouts,
-                                   seed=args.seed, evaluate_every=args.evaluate_every, start=args.start)
+                                   seed=args.seed, evaluate_every=args.evaluate_every, start=args.start,
+                                   select={"likelihood": "log_likelihood"}.get(args.select, args.select))
     last_seed = training_seed(args.iterations, args.rollouts - 1, args.rollouts)
     context = {"commit": git_commit(), **condition.provenance(),
                "training_rollout_seeds": f"{training_seed(1, 0, args.rollouts)}-{last_seed}",
@@ -236,8 +242,10 @@ def learn_trajectory(args: argparse.Namespace, out):
     c = condition.condition
     print(f"trajectory MaxEnt IRL (eq. 7.7): {condition.task}/{condition.kitchen}, budget {c.budget:g}, {c.turns} "
           f"turns, a change every {c.change_every}, data seed {condition.data_seed} ({condition.source}); "
-          f"{args.rollouts} rollouts an iteration, {len(held_out)} validation episodes every "
-          f"{args.evaluate_every} iteration(s)", file=out, flush=True)
+          f"{args.rollouts} rollouts an iteration; kept by {args.select}"
+          + (f" ({len(held_out)} validation episodes every {args.evaluate_every} iteration(s))"
+             if args.select == "accuracy" else f" ({len(held_out)} validation episodes score the kept iterate)"),
+          file=out, flush=True)
     best = {"score": None, "iteration": 0}
 
     def progress(record, seconds: float) -> None:

@@ -183,7 +183,7 @@ def learn_trajectory_weights(demos: str | Path, rollouts, evaluate, config,
                   "gradient": "eq. 7.7: expert minus rollout feature counts per turn",
                   "optimizer": "adam", "learning_rate": config.learning_rate, "l2": config.l2,
                   "start": result.weights.provenance["start"],
-                  "select_by": "mean final accuracy of greedy DT episodes on the validation seeds",
+                  "select_by": SELECT_BY[config.select],
                   "commit": (context or {}).get("commit", "unknown"),
                   "demos": SHIPPED if str(demos) == SHIPPED else str(demos),
                   "demonstrations": demonstration_files(demos),
@@ -201,6 +201,14 @@ def learn_trajectory_weights(demos: str | Path, rollouts, evaluate, config,
                   "unidentified_features": ", ".join(result.unidentified_features) or "none"}
     weights = DecisionWeights(result.weights.feature_names, result.weights.values, provenance)
     return LearnedWeights(weights, result, train, held_out, time.perf_counter() - started)
+
+
+# what each FeatureMatchingConfig.select keeps, in the weights' provenance
+SELECT_BY = {"log_likelihood": "mean log-likelihood of the held-out demonstrations' choices (eq. 7.5); the validation "
+                           "seeds' accuracy is reported for the kept iterate",
+             "accuracy": "mean final accuracy of greedy DT episodes on the validation seeds",
+             "agreement": "agreement of greedy choices with the held-out demonstrations; the validation seeds' "
+                          "accuracy is reported for the kept iterate"}
 
 
 @dataclass(frozen=True)

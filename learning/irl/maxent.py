@@ -359,8 +359,9 @@ def make_result(names: tuple[str, ...], w: np.ndarray, identifiable: np.ndarray,
 
 def log_likelihood(turns: PaddedTurns, w: np.ndarray) -> float:
     """Mean per-turn log P(a_t | s_t, w) of the expert's choices under the MaxEnt policy."""
+    weights = torch.from_numpy(np.array(w, dtype=np.float64))  # a copy: the caller's may be read-only
     with torch.no_grad():
-        return float(_TorchTurns(turns, np.ones(turns.phi.shape[2])).mean_log_likelihood(torch.from_numpy(w)))
+        return float(_TorchTurns(turns, np.ones(turns.phi.shape[2])).mean_log_likelihood(weights))
 
 
 def feature_count_gap(turns: PaddedTurns, weights: np.ndarray) -> np.ndarray:

@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import torch
@@ -54,6 +54,10 @@ Progress = Callable[[IterationRecord, float], None]  # (this iteration's record,
 
 
 STARTS = ("per-turn", "zero")
+# which iterate is kept: the best held-out agreement of greedy choices with the expert's (ties: likelihood), the
+# best held-out log-likelihood of the expert's choices (eq. 7.5, the IRL objective; ties: agreement), or the best
+# task accuracy of greedy episodes on validation seeds (needs ``evaluate``; the CLI's criterion before issue 27)
+SELECTIONS = ("agreement", "log_likelihood", "accuracy")  # the first two as IrlConfig.select_by
 
 
 @dataclass(frozen=True)
@@ -71,6 +75,7 @@ class FeatureMatchingConfig:
     optimizer: str = "adam"  # or "gradient": plain ascent along the gap, x += learning_rate * gap
     expected_counts: bool = True  # learner's counts: the policy's expectation at each visited state (else sampled)
     start: str = "per-turn"  # iteration 0: the per-turn MaxEnt fit of the expert episodes, or "zero" (w = 0)
+    select: str = "agreement"  # SELECTIONS; "accuracy" needs ``evaluate``
 
     def __post_init__(self) -> None:
         for name in ("max_iterations", "rollouts_per_iteration", "evaluate_every"):
@@ -87,6 +92,8 @@ class FeatureMatchingConfig:
             raise ValueError("learning_rate must be > 0")
         if self.start not in STARTS:
             raise ValueError(f"start must be one of {', '.join(STARTS)}, got {self.start!r}")
+        if self.select not in SELECTIONS:
+            raise ValueError(f"select must be one of {', '.join(SELECTIONS)}, got {self.select!r}")
 
 
 def rollout_generator(seed: int, iteration: int, index: int) -> np.random.Generator:
@@ -128,14 +135,17 @@ def fit_feature_matching(expert: Sequence[QuestioningEpisode], rollouts: Rollout
     Iteration 0 is ``initial_weights`` if given, else the per-turn MaxEnt fit of ``expert``
     (with ``validation`` choosing its iterate; ``config.start="per-turn"``) or w = 0
     (``start="zero"``). Each iteration plays ``rollouts_per_iteration`` episodes with the current
-    weights (``rollouts(w, iteration, count)``). With ``evaluate`` the kept
-    weights are the evaluated iterate with the highest score (the thesis: the
-    best on held-out validation episodes), ties to the higher agreement with the
-    validation demonstrations, then to the earlier iteration. Without it: the
-    iterate whose greedy choices agree best with the validation episodes
-    (without them: the expert episodes), ties to the higher log-likelihood.
+    weights (``rollouts(w, iteration, count)``). Which iterate is kept (``config.select``), always on
+    the validation episodes (without them: the expert episodes), ties to the earlier iteration:
+    "agreement" (the default), the greedy choices' agreement with the expert's, ties to the higher
+    log-likelihood; "log_likelihood", the mean log-likelihood of the expert's choices (eq. 7.5), ties to
+    the higher agreement; "accuracy", the evaluated iterate with the best ``evaluate(w)`` (the task
+    accuracy on validation episodes), ties to the higher agreement. Under the first two, ``evaluate``,
+    if given, scores only the kept iterate.
     """
     config = config or FeatureMatchingConfig()
+    if config.select == "accuracy" and evaluate is None:
+        raise ValueError("select='accuracy' scores iterates by task accuracy: pass evaluate(w)")
     with compute_threads(config.threads):
         return _fit_feature_matching(expert, rollouts, validation, config, initial_weights, evaluate, progress)
 
@@ -172,15 +182,14 @@ def _fit_feature_matching(expert, rollouts: RolloutBatch, validation, config: Fe
         train_agreement = train_turns.agreement(w)
         validation_agreement = validation_turns.agreement(w) if validation_turns is not None else None
         agreement_key = held_out.agreement(w)
-        if evaluate is None:
-            return (IterationRecord(iteration, gap, train_agreement, validation_agreement),
-                    (agreement_key, log_likelihood(held_out, w)))
+        if config.select != "accuracy" or evaluate is None:  # (accuracy without evaluate is refused above)
+            likelihood = log_likelihood(held_out, w)
+            key = (likelihood, agreement_key) if config.select == "log_likelihood" else (agreement_key, likelihood)
+            return IterationRecord(iteration, gap, train_agreement, validation_agreement), key
         due = iteration % config.evaluate_every == 0 or iteration == config.max_iterations
         if not due:
             return IterationRecord(iteration, gap, train_agreement, validation_agreement), None
-        score = float(evaluate(w))
-        if not np.isfinite(score):
-            raise ValueError(f"the evaluation of iteration {iteration} returned {score}; it must be a finite number")
+        score = checked_score(evaluate(w), iteration)
         return IterationRecord(iteration, gap, train_agreement, validation_agreement, score), (score, agreement_key)
 
     best_w = w0.copy()
@@ -206,16 +215,27 @@ def _fit_feature_matching(expert, rollouts: RolloutBatch, validation, config: Fe
             best_key, best_w, best_iteration = key, w, iteration
         if progress is not None:
             progress(entry, time.perf_counter() - started)
+    if evaluate is not None and config.select != "accuracy":  # the kept iterate's task accuracy, for the record
+        kept = history[best_iteration]
+        history[best_iteration] = replace(kept, evaluation=checked_score(evaluate(best_w), best_iteration))
     settings = {"method": "maxent-irl-feature-matching", "optimizer": config.optimizer, "l2": float(config.l2),
                 "learning_rate": float(config.learning_rate),
                 "rollouts_per_iteration": config.rollouts_per_iteration,
                 "learner_counts": "expected under the policy" if config.expected_counts else "sampled",
                 "start": start,
-                "select_by": "evaluation" if evaluate is not None else "agreement"}
-    if evaluate is not None:
+                "select_by": "evaluation" if config.select == "accuracy" else config.select}
+    if evaluate is not None and config.select == "accuracy":
         settings["evaluate_every"] = config.evaluate_every
     return make_result(names, best_w, identifiable, history, best_iteration, config.max_iterations, False, settings,
                        train_turns, validation_turns, started)
+
+
+def checked_score(score, iteration: int) -> float:
+    """An evaluation's score as a float; a non-finite one is a bug in the caller's ``evaluate``."""
+    score = float(score)
+    if not np.isfinite(score):
+        raise ValueError(f"the evaluation of iteration {iteration} returned {score}; it must be a finite number")
+    return score
 
 
 def _checked(episode, names: tuple[str, ...]) -> QuestioningEpisode:

@@ -51,12 +51,13 @@ def test_the_start_of_the_ascent(expert):
     """start="zero" is the earlier default (w = 0); given initial weights win over either start."""
     train, validation, _ = expert
     zero = fit_feature_matching(train, serial_rollouts(learner_rollout), validation,
-                                FeatureMatchingConfig(max_iterations=1, rollouts_per_iteration=1, start="zero"),
+                                FeatureMatchingConfig(max_iterations=1, rollouts_per_iteration=1, start="zero",
+                                                      select="accuracy"),
                                 evaluate=lambda w: -float(np.abs(w).sum()))  # keeps iteration 0
     assert zero.best_iteration == 0 and not np.any(zero.weights.values)
     assert zero.weights.provenance["start"] == "zero"
     given = fit_feature_matching(train, serial_rollouts(learner_rollout), validation,
-                                 FeatureMatchingConfig(max_iterations=1, rollouts_per_iteration=1),
+                                 FeatureMatchingConfig(max_iterations=1, rollouts_per_iteration=1, select="accuracy"),
                                  initial_weights=TRUE_WEIGHTS,
                                  evaluate=lambda w: -float(np.abs(w - TRUE_WEIGHTS).sum()))
     assert given.weights.provenance["start"] == "given"
@@ -74,7 +75,8 @@ def test_the_evaluated_iterate_with_the_best_score_is_kept(expert):
         calls.append(weights.copy())
         return next(scores)
 
-    config = FeatureMatchingConfig(max_iterations=9, rollouts_per_iteration=1, seed=1, evaluate_every=2)
+    config = FeatureMatchingConfig(max_iterations=9, rollouts_per_iteration=1, seed=1, evaluate_every=2,
+                                   select="accuracy")
     result = fit_feature_matching(train, serial_rollouts(learner_rollout, seed=1), validation, config,
                                   evaluate=evaluate)
     evaluated = [record.iteration for record in result.history if record.evaluation is not None]
@@ -84,13 +86,45 @@ def test_the_evaluated_iterate_with_the_best_score_is_kept(expert):
     assert result.weights.provenance["select_by"] == "evaluation"
     seen = []
     fit_feature_matching(train, serial_rollouts(learner_rollout, seed=1), validation,
-                         FeatureMatchingConfig(max_iterations=2, rollouts_per_iteration=1),
+                         FeatureMatchingConfig(max_iterations=2, rollouts_per_iteration=1, select="accuracy"),
                          evaluate=lambda w: 0.5, progress=lambda record, seconds: seen.append(record.iteration))
     assert seen == [0, 1, 2]
     with pytest.raises(ValueError, match="the evaluation of iteration 0 returned nan"):
         fit_feature_matching(train, serial_rollouts(learner_rollout), validation,
-                             FeatureMatchingConfig(max_iterations=1, rollouts_per_iteration=1),
+                             FeatureMatchingConfig(max_iterations=1, rollouts_per_iteration=1, select="accuracy"),
                              evaluate=lambda w: float("nan"))
+
+
+def test_selection_by_likelihood_or_agreement_scores_only_the_kept_iterate(expert):
+    """select="log_likelihood" keeps the iterate with the best held-out log-likelihood (eq. 7.5); evaluate(w) then
+    runs once, on the kept weights, for the record. "accuracy" without evaluate is refused."""
+    from learning.irl.maxent import PaddedTurns, log_likelihood
+
+    train, validation, _ = expert
+    held_out = PaddedTurns(validation, "validation")
+    calls, iterates = [], []
+    config = FeatureMatchingConfig(max_iterations=6, rollouts_per_iteration=1, seed=1, start="zero",
+                                   select="log_likelihood")
+    result = fit_feature_matching(train, serial_rollouts(learner_rollout, seed=1), validation, config,
+                                  evaluate=lambda w: calls.append(w.copy()) or 0.25)
+    assert len(calls) == 1 and result.weights.provenance["select_by"] == "log_likelihood"
+    np.testing.assert_array_equal(calls[0], result.weights.values)
+    assert [record.evaluation for record in result.history].count(0.25) == 1
+    assert result.history[result.best_iteration].evaluation == 0.25
+    again = fit_feature_matching(train, serial_rollouts(learner_rollout, seed=1), validation, config,
+                                 progress=lambda record, seconds: iterates.append(record.iteration))
+    assert iterates == list(range(7)) and again.weights.values.tobytes() == result.weights.values.tobytes()
+    assert log_likelihood(held_out, result.weights.values) == pytest.approx(result.validation_log_likelihood)
+    by_agreement = fit_feature_matching(train, serial_rollouts(learner_rollout, seed=1), validation,
+                                        FeatureMatchingConfig(max_iterations=6, rollouts_per_iteration=1, seed=1,
+                                                              start="zero"))
+    assert by_agreement.weights.provenance["select_by"] == "agreement"
+    assert held_out.agreement(by_agreement.weights.values) >= held_out.agreement(result.weights.values)
+    with pytest.raises(ValueError, match="select='accuracy' scores iterates by task accuracy: pass evaluate"):
+        fit_feature_matching(train, serial_rollouts(learner_rollout), validation,
+                             FeatureMatchingConfig(max_iterations=1, rollouts_per_iteration=1, select="accuracy"))
+    with pytest.raises(ValueError, match="select must be one of agreement, log_likelihood, accuracy"):
+        FeatureMatchingConfig(select="best")
 
 
 def test_serial_rollouts_are_deterministic_by_seed_and_iteration():
