@@ -1,66 +1,84 @@
-"""Time `teachbot learn-weights --demos shipped` against references measured in the same run.
+"""Time `teachbot learn-weights` by each method, with `teachbot --help` (start-up) as the reference in the same run.
 
-Figures: the whole command as a subprocess (interpreter start-up included), learn_weights in-process (load,
-split, fit), loading the shipped demonstrations alone, and `teachbot --help` (the start-up reference); plus the
-validation agreement. The last line is JSON with --json.
+Rows, each the whole command as a subprocess on the shipped demonstrations (docs/irl.md):
+- imitation (the default): the issue-27 protocol, 3 splits x 5 fit seeds x 2 policy forms of per-turn MaxEnt;
+- per-turn: one per-turn MaxEnt fit;
+- trajectory, --select likelihood (the default) and --select accuracy (the criterion before issue 27): eq. 7.7
+  with rollouts of the real dialog loop in the training condition (goal: <= 10 min for one fit with rollouts).
+Beside each: the kept iterate and, from the written weights' provenance, its held-out imitation and validation
+accuracy. The last line is JSON with --json.
 
-    .venv/bin/python scripts/bench_irl.py [--repeats 3] [--json]
+    .venv/bin/python scripts/bench_irl.py [--iterations 100] [--skip-trajectory] [--json]
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import os
 import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
-
-from learning.irl.learn import learn_weights, load_demonstrations  # noqa: E402
+import tomllib
 
 TEACHBOT = str(Path(sys.executable).with_name("teachbot"))
 
 
-def best_of(repeats: int, work) -> float:
-    times = []
-    for _ in range(repeats):
-        started = time.perf_counter()
-        work()
-        times.append(time.perf_counter() - started)
-    return min(times)
+def timed(command: list[str]) -> tuple[float, float]:
+    """(wall seconds, CPU seconds of the child) of one command, which must succeed."""
+    before = os.times()
+    started = time.perf_counter()
+    done = subprocess.run(command, capture_output=True, text=True, check=False)
+    wall = time.perf_counter() - started
+    after = os.times()
+    if done.returncode != 0:
+        sys.exit(f"bench_irl: {' '.join(command)} failed:\n{done.stderr}")
+    return wall, (after.children_user - before.children_user) + (after.children_system - before.children_system)
+
+
+def provenance(path: Path) -> dict:
+    with path.open("rb") as handle:
+        return tomllib.load(handle).get("provenance", {})
+
+
+def row(name: str, options: list[str], scratch: Path) -> dict:
+    out = scratch / f"{name}.toml"
+    wall, cpu = timed([TEACHBOT, "learn-weights", "--demos", "shipped", "--out", str(out), *options])
+    p = provenance(out)
+    picked = {key: p.get(key) for key in ("best_iteration", "held_out_agreement", "held_out_exact_agreement",
+                                          "held_out_ask_or_quiet_agreement", "held_out_log_likelihood",
+                                          "validation_accuracy", "select_by", "select_iterate_by")
+              if key in p}
+    return {"method": name, "options": " ".join(options), "wall_seconds": round(wall, 2),
+            "cpu_seconds": round(cpu, 2), **picked}
 
 
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--iterations", type=int, default=100, help="trajectory iterations (default 100, as shipped)")
+    parser.add_argument("--skip-trajectory", action="store_true", help="time the per-turn methods only")
     parser.add_argument("--json", action="store_true")
     args = parser.parse_args()
+    startup, _ = timed([TEACHBOT, "--help"])
+    rows = []
     with tempfile.TemporaryDirectory() as scratch:
-        out = Path(scratch) / "w.toml"
-        command = best_of(args.repeats, lambda: subprocess.run(
-            [TEACHBOT, "learn-weights", "--demos", "shipped", "--out", str(out)], check=True, capture_output=True))
-    startup = best_of(args.repeats, lambda: subprocess.run([TEACHBOT, "--help"], check=True, capture_output=True))
-    learn_weights("shipped")  # first call imports torch
-    in_process = best_of(args.repeats, lambda: learn_weights("shipped"))
-    loading = best_of(args.repeats, lambda: load_demonstrations("shipped"))
-    learned = learn_weights("shipped")
-    figures = {"command_seconds": round(command, 3), "startup_seconds": round(startup, 3),
-               "learn_in_process_seconds": round(in_process, 4), "fit_seconds": round(learned.result.seconds, 4),
-               "load_seconds": round(loading, 4), "iterations": learned.result.iterations,
-               "train_turns": learned.result.train_turns, "validation_turns": learned.result.validation_turns,
-               "validation_agreement": learned.result.validation_agreement,
-               "validation_ask_or_quiet_agreement": learned.weights.provenance.get(
-                   "validation_ask_or_quiet_agreement")}
-    print(f"teachbot learn-weights --demos shipped: {command:.2f} s (teachbot --help: {startup:.2f} s; limit 60 s)")
-    print(f"in process: {in_process:.3f} s = loading {loading:.3f} s + fit {learned.result.seconds:.3f} s "
-          f"({learned.result.iterations} iterations, {learned.result.train_turns} training turns)")
-    print(f"validation agreement {learned.result.validation_agreement:.3f} on {learned.result.validation_turns} turns")
+        rows.append(row("imitation", [], Path(scratch)))
+        rows.append(row("per-turn", ["--method", "per-turn"], Path(scratch)))
+        if not args.skip_trajectory:
+            for select in ("likelihood", "accuracy"):
+                rows.append(row(f"trajectory-{select}", ["--method", "trajectory", "--iterations",
+                                                         str(args.iterations), "--select", select], Path(scratch)))
+    print(f"teachbot --help (start-up): {startup:.2f} s")
+    for r in rows:
+        scores = ", ".join(f"{k} {v}" for k, v in r.items()
+                           if k not in ("method", "options", "wall_seconds", "cpu_seconds"))
+        print(f"{r['method']:<22} {r['wall_seconds']:>8.1f} s wall, {r['cpu_seconds']:>8.1f} s CPU"
+              f" ({r['wall_seconds'] / startup:.0f}x start-up); {scores}")
     if args.json:
-        print(json.dumps(figures))
+        print(json.dumps({"startup_seconds": round(startup, 3), "rows": rows}))
     return 0
 
 
