@@ -14,7 +14,7 @@ from pathlib import Path
 
 from bullet_world.datafiles import available, resolve
 from dialog.clock import VirtualClock, WallClock
-from dialog.episode import make_teacher
+from dialog.episode import build_episode, embodied_timing, make_teacher
 from dialog.manager import DialogManager, episode_generators
 from dialog.settings import EpisodeSettings
 from dialog.teachers.scripted import SCRIPTED_OPTIONS
@@ -192,11 +192,7 @@ def session_teacher(settings: SessionSettings, rngs, clock, input_stream=None, o
     """The session's teacher, from its recorded kind and options (``dialog.episode.make_teacher``)."""
     kind = settings.teacher["kind"]
     options = {key: settings.teacher[key] for key in SCRIPTED_OPTIONS if key in settings.teacher and kind == "scripted"}
-    delays = None
-    if settings.seconds is not None and kind == "scripted":  # embodied costs: the per-kind answer times
-        from dialog.embodied import load_embodied_costs
-
-        delays = load_embodied_costs().answer
+    delays = embodied_timing(settings.seconds).answer_delays if kind == "scripted" else None  # embodied costs
     return make_teacher(kind, rng=rngs["teacher"], clock=clock, transcript=settings.teacher.get("transcript"),
                         input_stream=input_stream, output_stream=output_stream, answer_delays=delays, **options)
 
@@ -231,9 +227,8 @@ def open_session(settings: SessionSettings, environment, transcript_path: str | 
     elif getattr(teacher, "clock", False) is None:
         teacher.clock = clock
     transcript = TranscriptWriter(transcript_path, append=resume, lock=lock)
-    manager = DialogManager(environment, teacher, settings.build_strategy(), settings.config(pictures),
-                            transcript, rngs, say=say or print, observers=observers, clock=clock,
-                            session=settings.header())
+    manager = build_episode(settings, environment, teacher, transcript, rngs=rngs, say=say or print,
+                            observers=observers, clock=clock, pictures=pictures, session=settings.header())
     try:
         replay(manager, numbered, transcript_path)
     except BaseException:

@@ -18,6 +18,7 @@ from dialog.user_weights import weights_from_record
 from learning.actions import DEFAULT_COSTS
 from learning.errors import SettingsError
 from learning.limits import check_limit, check_questions
+from learning.strategies import DEFAULT_STRATEGY
 
 __all__ = ["DEFAULTS", "EpisodeSettings", "check_allocation", "check_costs"]
 
@@ -69,7 +70,7 @@ class EpisodeSettings:
 
     task: str = "pack-lunchbox"
     kitchen: str = "kitchen-1"
-    strategy: str = "active"
+    strategy: str = DEFAULT_STRATEGY
     seed: int = 0
     turns: int = 30
     budget: float = 40.0

@@ -13,7 +13,7 @@ import sys
 from dataclasses import dataclass
 from pathlib import Path
 
-from learning.decision.features import FEATURE_NAMES
+from learning.decision.habits import EXTENDED_FEATURE_NAMES
 from learning.decision.weights import PRESETS, weight_vector
 from learning.decision.weights_file import load_weights
 from learning.errors import DataFileError, SettingsError, TranscriptError
@@ -115,11 +115,11 @@ def weights_from_record(recorded) -> UserWeights:
     values = recorded.get("values") if isinstance(recorded, dict) else None
     file = recorded.get("file") if isinstance(recorded, dict) else None
     good = isinstance(values, dict) and values and isinstance(file, str) and file and all(
-        name in FEATURE_NAMES and isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v)
+        name in EXTENDED_FEATURE_NAMES and isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v)
         for name, v in values.items())
     if not good:
         raise SettingsError("weights must be a table with the weights file and its values, one finite number per "
-                            f"decision feature of {', '.join(FEATURE_NAMES)}; got {recorded!r:.120}")
+                            f"decision feature of {', '.join(EXTENDED_FEATURE_NAMES)}; got {recorded!r:.120}")
     return UserWeights(file, tuple((name, float(v)) for name, v in values.items()))
 
 

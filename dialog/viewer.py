@@ -4,7 +4,7 @@ Wiring, in a command module::
 
     add_viewer_option(parser)                                   # in register()
     with viewer_observers(args, environment.world) as observers:  # in run()
-        manager = DialogManager(..., observers=observers)
+        manager = build_episode(settings, environment, ..., observers=observers)
         result = manager.run()
 
 If the viewer can't start, one warning line goes to standard error and the

@@ -22,7 +22,7 @@ from learning.concepts import checked_rows, normalise_rows
 from learning.errors import SettingsError, TeachbotError
 from learning.limits import check_limit, check_questions
 from learning.state import LearningState
-from learning.strategies import Strategy, make_strategy
+from learning.strategies import DEFAULT_STRATEGY, Strategy, make_strategy
 
 QUERY_KINDS = ACTION_KINDS
 
@@ -57,7 +57,7 @@ class Turn:
 class TeachingLoop:
     """A learner that asks a teacher about scenes of objects (rows of feature values) within a budget."""
 
-    def __init__(self, concepts, strategy: str | Strategy = "dt-task", budget: float = 40, turns: int = 30,
+    def __init__(self, concepts, strategy: str | Strategy = DEFAULT_STRATEGY, budget: float = 40, turns: int = 30,
                  change_every: int = 5, costs: dict | None = None, seed: int | np.random.Generator = 0,
                  feature_names=None):
         self.concepts, self._names = _concept_names(concepts)

@@ -24,10 +24,11 @@ from pathlib import Path
 import numpy as np
 
 from dialog.environment import SimulatedKitchen
-from dialog.manager import DialogManager, EpisodeConfig, episode_generators
+from dialog.episode import build_episode
+from dialog.manager import episode_generators
+from dialog.settings import EpisodeSettings
 from dialog.teachers.scripted import ScriptedTeacher
 from dialog.transcripts.jsonl import TranscriptWriter
-from learning.strategies import make_strategy
 
 GOAL_SECONDS = 10.0
 
@@ -61,15 +62,17 @@ def run_episode(args, seed: int, mislabel_rate: float, folder: Path) -> dict:
     kitchen = SimulatedKitchen(task=args.task, kitchen=args.kitchen, seed=seed, pictures=args.pictures)
     built = time.perf_counter()
     environment = Timed(kitchen, ("point_at", "next_scene", "test_set", "fetch"))
-    strategy = Timed(make_strategy(args.strategy), ("choose",))
+    settings = EpisodeSettings(task=args.task, kitchen=args.kitchen, strategy=args.strategy, seed=seed,
+                               turns=args.turns, budget=args.budget, change_every=args.change_every)
+    strategy = Timed(settings.build_strategy(), ("choose",))
     strategy.name = args.strategy
-    config = EpisodeConfig(turns=args.turns, budget=args.budget, change_every=args.change_every, seed=seed,
-                           pictures=str(folder / f"pictures-{seed}") if args.pictures else None)
+    pictures = str(folder / f"pictures-{seed}") if args.pictures else None
     rngs = episode_generators(seed)
     teacher = ScriptedTeacher(rngs["teacher"], mislabel_rate=mislabel_rate)
     try:
         with TranscriptWriter(folder / f"episode-{seed}-{mislabel_rate}.jsonl") as transcript:
-            manager = DialogManager(environment, teacher, strategy, config, transcript, rngs, say=lambda _: None)
+            manager = build_episode(settings, environment, teacher, transcript, strategy=strategy, rngs=rngs,
+                                    say=lambda _: None, pictures=pictures)
             manager.begin()
             began, began_cpu = time.perf_counter(), time.process_time()
             result = manager.run()

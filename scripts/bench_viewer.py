@@ -28,10 +28,11 @@ from pathlib import Path
 from bullet_world.viewer.mirror import Viewer
 from bullet_world.viewer.snapshot import CHROMIUM_FLAGS, COUNT_DRAWN_JS, find_chromium
 from dialog.environment import SimulatedKitchen
-from dialog.manager import DialogManager, EpisodeConfig, episode_generators
+from dialog.episode import build_episode
+from dialog.manager import episode_generators
+from dialog.settings import EpisodeSettings
 from dialog.teachers.scripted import OracleTeacher
 from dialog.transcripts.jsonl import TranscriptWriter
-from learning.strategies import make_strategy
 
 GOAL = 0.20
 SETTLE_S = 1.0  # pause after each session, so that one session's leftovers don't slow the next
@@ -80,11 +81,11 @@ def episode(condition: str, args, folder: Path) -> dict:
             if browser is not None:
                 browser.show(viewer.url, min_drawn=10)
         rngs = episode_generators(args.seed)
-        config = EpisodeConfig(turns=args.turns, budget=args.budget, change_every=args.change_every, seed=args.seed)
+        settings = EpisodeSettings(task=args.task, kitchen=args.kitchen, strategy=args.strategy, seed=args.seed,
+                                   turns=args.turns, budget=args.budget, change_every=args.change_every)
         with TranscriptWriter(folder / f"{condition}.jsonl") as transcript:
-            manager = DialogManager(environment, OracleTeacher(rngs["teacher"]), make_strategy(args.strategy),
-                                    config, transcript, rngs, say=lambda *_: None,
-                                    observers=(viewer,) if viewer is not None else ())
+            manager = build_episode(settings, environment, OracleTeacher(rngs["teacher"]), transcript, rngs=rngs,
+                                    say=lambda *_: None, observers=(viewer,) if viewer is not None else ())
             episode_started = time.perf_counter()
             result = manager.run()
             episode_seconds = time.perf_counter() - episode_started

@@ -137,3 +137,22 @@ def test_the_graph_sees_imports_inside_functions(tmp_path):
     sample = tmp_path / "sample.py"
     sample.write_text("def late():\n    from dialog.cli import main\n")
     assert imported_modules("dialog.sample", sample, {"dialog.cli": sample, "dialog": sample}) == {"dialog.cli"}
+
+
+def test_one_episode_builder_wires_the_manager():
+    """Issue 25: ``dialog.episode.build_episode`` is the one place a DialogManager is made; every command, suite,
+    the Gymnasium environment and the scripts call it."""
+    makers = sorted(str(path.relative_to(ROOT)) for package in (*HOUSE, "scripts")
+                    for path in (ROOT / package).rglob("*.py")
+                    if "DialogManager(" in path.read_text(encoding="utf-8"))
+    assert makers == ["dialog/episode.py"]
+
+
+def test_the_default_strategy_is_written_once():
+    from dialog.commands.teach import DEFAULT_STRATEGY as teach_default
+    from dialog.settings import DEFAULTS
+    from learning import TeachingLoop
+    from learning.strategies import DEFAULT_STRATEGY
+
+    assert DEFAULTS.strategy == teach_default == DEFAULT_STRATEGY == "dt-task"
+    assert TeachingLoop(["a", "b"]).strategy.name == DEFAULT_STRATEGY

@@ -7,14 +7,13 @@ import json
 from dataclasses import asdict
 from pathlib import Path
 
-from dialog.clock import VirtualClock
 from dialog.commands._arguments import add_episode_options, add_time_options, resolve_time
 from dialog.commands._arguments import seconds as seconds_type
 from dialog.commands._summary import questions_in_words, scene_size
-from dialog.commands.teach import DEFAULT_STRATEGY
 from dialog.environment import SimulatedKitchen
+from dialog.episode import build_episode, embodied_timing
 from dialog.experiments.runner import file_label
-from dialog.manager import DialogManager, episode_generators
+from dialog.manager import episode_generators
 from dialog.output_paths import file_argument
 from dialog.settings import DEFAULTS, EpisodeSettings
 from dialog.teachers.scripted import OracleTeacher
@@ -24,7 +23,7 @@ from dialog.user_weights import WEIGHTS_STRATEGY_NAME, add_weights_option, weigh
 from dialog.viewer import DEFAULT_PACE_S, Pacer, add_viewer_option, hold_viewer, pace_of, viewer_observers
 from dialog.web.session import add_web_options, check_web_options
 from learning.errors import TranscriptError
-from learning.strategies import STRATEGY_NAMES, make_strategy
+from learning.strategies import DEFAULT_STRATEGY, STRATEGY_NAMES
 
 SUMMARY_KEYS = ("seed", "strategy", "turns", "budget_spent", "queries", "accuracy", "transcript", "seconds")
 
@@ -84,34 +83,30 @@ def run(args: argparse.Namespace) -> int:
     check_web_options(args)
     turns, seconds = resolve_time(args)
     args.strategy, weights = weights_strategy(args.strategy, args.weights)  # --weights: DT shown as "dt"
-    strategy = make_strategy(args.strategy) if weights is None else weights.strategy(WEIGHTS_STRATEGY_NAME)
     session = {"command": "demo"} if weights is None else {"command": "demo", "weights": weights.record()}
     if weights is not None:
         print(f"Strategy {WEIGHTS_STRATEGY_NAME}: DT with the weights in {weights.describe()}", flush=True)
     settings = EpisodeSettings(task=args.task, kitchen=args.kitchen, strategy=args.strategy, seed=args.seed,
-                               turns=turns, budget=args.budget, change_every=args.change_every, seconds=seconds)
-    config = settings.config()
-    clock, delays, joint_speed = None, None, None
-    if seconds is not None:  # embodied costs: one clock for the arm, the turns and the teacher's answers
-        from dialog.embodied import load_embodied_costs
-
-        costs = load_embodied_costs()
-        clock, delays, joint_speed = VirtualClock(), costs.answer, costs.joint_speed
+                               turns=turns, budget=args.budget, change_every=args.change_every, seconds=seconds,
+                               weights=None if weights is None else weights.record())
+    strategy = settings.build_strategy()  # before anything is opened: a strategy that can't be built is one line
+    timing = embodied_timing(seconds)
     rngs = episode_generators(args.seed)
     transcript_path = args.transcript or default_transcript(args, seconds)
     lock = TranscriptLock(transcript_path)  # checked and held before the kitchen is built: one writer per file
     try:
         refuse_foreign_transcript(transcript_path, lock)
-        environment = SimulatedKitchen(task=args.task, kitchen=args.kitchen, seed=args.seed, joint_speed=joint_speed)
+        environment = SimulatedKitchen(task=args.task, kitchen=args.kitchen, seed=args.seed,
+                                       joint_speed=timing.joint_speed)
         pace = pace_of(args)
         try:
             if args.web:
                 _watch_in_page(args, environment, pace, lambda observers: _episode(
-                    args, environment, strategy, config, transcript_path, lock, rngs, clock, delays, session,
-                    observers))
+                    args, environment, settings, strategy, transcript_path, lock, rngs, timing,
+                    session, observers))
             else:
                 with viewer_observers(args, environment.world) as observers:
-                    _episode(args, environment, strategy, config, transcript_path, lock, rngs, clock, delays,
+                    _episode(args, environment, settings, strategy, transcript_path, lock, rngs, timing,
                              session, ((Pacer(pace),) if pace > 0 else ()) + observers)
                     hold_viewer(args, observers[0] if observers else None)
         finally:
@@ -121,11 +116,11 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _episode(args, environment, strategy, config, transcript_path, lock, rngs, clock, delays, session, observers):
+def _episode(args, environment, settings, strategy, transcript_path, lock, rngs, timing, session, observers):
     with TranscriptWriter(transcript_path, lock=lock) as transcript:
-        teacher = OracleTeacher(rngs["teacher"], clock=clock, answer_delays=delays)
-        manager = DialogManager(environment, teacher, strategy, config, transcript, rngs,
-                                observers=observers, session=session, clock=clock)
+        teacher = OracleTeacher(rngs["teacher"], clock=timing.clock, answer_delays=timing.answer_delays)
+        manager = build_episode(settings, environment, teacher, transcript, strategy=strategy, rngs=rngs,
+                                observers=observers, session=session, clock=timing.clock)
         result = manager.run()
     return _print_summary(args, result, environment, manager)
 

@@ -19,6 +19,7 @@ from dialog.commands._arguments import (
 from dialog.commands._resume import check_resume_options, continue_command
 from dialog.commands._summary import questions_in_words, scene_size, session_time
 from dialog.environment import SimulatedKitchen
+from dialog.episode import embodied_timing
 from dialog.experiments.runner import file_label
 from dialog.output_paths import check_writable, file_argument
 from dialog.session import TEACHERS, SessionSettings, open_session
@@ -28,11 +29,7 @@ from dialog.user_weights import add_weights_option, weights_strategy
 from dialog.viewer import add_viewer_option, hold_viewer, start_viewer, stop_viewer
 from dialog.web.session import add_web_options, check_web_options
 from learning.errors import OutputPathError, SettingsError, TranscriptError
-from learning.strategies import STRATEGY_NAMES
-
-PREFERRED_STRATEGIES = ("dt-task", "dt", "all-cd", "active")
-DEFAULT_STRATEGY = next(name for name in (*PREFERRED_STRATEGIES, STRATEGY_NAMES[0]) if name in STRATEGY_NAMES)
-
+from learning.strategies import DEFAULT_STRATEGY, STRATEGY_NAMES
 
 rate = number_within(float, 0.0, 1.0, "a number between 0 and 1")
 
@@ -160,11 +157,7 @@ def _teach(args, settings: SessionSettings, path: Path, lock: TranscriptLock, in
     person = settings.teacher["kind"] == "terminal"
     pictures = _picture_folder(args, path, person)
     out = output_stream or sys.stdout
-    joint_speed = None
-    if settings.seconds is not None:  # embodied costs: the arm's gestures paced by its joint-speed limit
-        from dialog.embodied import load_embodied_costs
-
-        joint_speed = load_embodied_costs().joint_speed
+    joint_speed = embodied_timing(settings.seconds).joint_speed  # embodied costs: the arm's joint-speed limit
     environment = SimulatedKitchen(task=settings.task, kitchen=settings.kitchen, seed=settings.seed,
                                    pictures=pictures is not None, joint_speed=joint_speed)
     viewer = page = None

@@ -12,12 +12,11 @@ from pathlib import Path
 
 import numpy as np
 
-from dialog.clock import VirtualClock
-from dialog.embodied import load_embodied_costs, make_episode_strategy
-from dialog.episode import make_teacher
+from dialog.embodied import load_embodied_costs
+from dialog.episode import build_episode, embodied_timing, make_teacher
 from dialog.experiments.pools import PoolEnvironment, load_pools
 from dialog.experiments.suite import Condition
-from dialog.manager import DialogManager, episode_generators
+from dialog.manager import episode_generators
 from dialog.settings import EpisodeSettings
 from dialog.threads import one_blas_thread
 from dialog.transcripts.jsonl import TranscriptWriter, read_transcript
@@ -58,7 +57,8 @@ class EpisodeSpec:
         condition = self.condition
         return EpisodeSettings(task=self.task, kitchen=self.kitchen, strategy=self.strategy, seed=self.episode_seed,
                                turns=condition.turns, budget=condition.budget, change_every=condition.change_every,
-                               costs=dict(self.costs), seconds=condition.seconds)
+                               costs=dict(self.costs), seconds=condition.seconds,
+                               weights=None if self.weights is None else self.weights.record())
 
 
 TEACHER_OPTIONS = ("kind", "mislabel_rate", "dont_know_rate", "feature_quality", "feature_recall", "feature_noise",
@@ -95,18 +95,14 @@ def _run_episode(spec: EpisodeSpec, strategy: Strategy | None = None) -> dict:
         scenes = max(1, int(-(-condition.seconds // load_embodied_costs().scene_seconds(condition.change_every))))
     environment = PoolEnvironment(pools.train[spec.dataset], pools.test, pools.task, scenes,
                                   condition.objects_per_scene)
-    config = spec.settings().config()
-    rngs = episode_generators(spec.episode_seed)
-    if strategy is None:
-        strategy = make_episode_strategy(spec.strategy) if spec.weights is None else \
-            spec.weights.strategy(spec.strategy)
-    clock, delays = None, None
-    if condition.seconds is not None:  # embodied costs: one clock for the arm, the turns and the teacher's answers
-        clock, delays = VirtualClock(), load_embodied_costs().answer
+    settings = spec.settings()
+    rngs = episode_generators(settings.seed)
+    timing = embodied_timing(condition.seconds)
+    teacher = suite_teacher(dict(spec.teacher), rngs["teacher"], timing.clock, timing.answer_delays)
     Path(spec.transcript).parent.mkdir(parents=True, exist_ok=True)
     with TranscriptWriter(spec.transcript) as transcript:
-        result = DialogManager(environment, suite_teacher(dict(spec.teacher), rngs["teacher"], clock, delays),
-                               strategy, config, transcript, rngs, say=lambda _: None, clock=clock).run()
+        result = build_episode(settings, environment, teacher, transcript, strategy=strategy, rngs=rngs,
+                               say=lambda _: None, clock=timing.clock).run()
     series = series_from_transcript(read_transcript(spec.transcript))
     return {"spec": asdict(spec), "label": spec.label, "series": series, "accuracy": result.accuracy,
             "seconds": time.perf_counter() - started, "cpu_seconds": time.process_time() - started_cpu}

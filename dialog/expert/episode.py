@@ -26,7 +26,8 @@ from typing import Protocol
 import numpy as np
 
 from dialog.clock import VirtualClock
-from dialog.manager import DialogManager, EpisodeResult, episode_generators
+from dialog.episode import build_episode
+from dialog.manager import EpisodeResult, episode_generators
 from dialog.settings import EpisodeSettings
 from dialog.teachers.scripted import ScriptedTeacher
 from dialog.transcripts.jsonl import TranscriptWriter
@@ -186,7 +187,7 @@ def run_expert_episode(settings: ExpertSettings, chooser: Chooser, out_dir: str 
         session = {"command": "expert", "task": settings.task, "kitchen": settings.kitchen,
                    "teacher": teacher.options(), "expert": chooser.name}
         with TranscriptWriter(transcript_path) as transcript:
-            manager = DialogManager(environment, teacher, strategy, settings.config(), transcript, rngs, say=say,
+            manager = build_episode(settings, environment, teacher, transcript, strategy=strategy, rngs=rngs, say=say,
                                     observers=(strategy, *observers), clock=clock, session=session)
             started = time.perf_counter()
             try:

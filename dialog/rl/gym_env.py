@@ -44,6 +44,7 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
+from dialog.episode import build_episode
 from dialog.experiments.episodes import suite_teacher
 from dialog.experiments.irl_rollouts import training_condition
 from dialog.experiments.pools import PoolEnvironment, load_pools
@@ -168,12 +169,11 @@ class QuestioningEnv(gym.Env):
         dataset = self.episode_seed % s.datasets if dataset is None else dataset
         world = PoolEnvironment(self.pools.train[dataset], self.pools.test, self.pools.task, scenes)
         rngs = episode_generators(self.episode_seed)
-        config = EpisodeSettings(task=s.task, kitchen=s.kitchen, strategy=AgentChooses.name, seed=self.episode_seed,
-                                 turns=s.turns, budget=s.budget, change_every=s.change_every,
-                                 costs=dict(s.costs)).config()
+        settings = EpisodeSettings(task=s.task, kitchen=s.kitchen, strategy=AgentChooses.name, seed=self.episode_seed,
+                                   turns=s.turns, budget=s.budget, change_every=s.change_every, costs=dict(s.costs))
         transcript = MemoryTranscript() if self.transcript_path is None else TranscriptWriter(self.transcript_path)
-        self.manager = DialogManager(world, suite_teacher(dict(s.teacher), rngs["teacher"]), AgentChooses(), config,
-                                     transcript, rngs, say=lambda _: None,
+        self.manager = build_episode(settings, world, suite_teacher(dict(s.teacher), rngs["teacher"]), transcript,
+                                     strategy=AgentChooses(), rngs=rngs, say=lambda _: None,
                                      session={"environment": ENV_ID, "dataset": dataset, "data_seed": s.data_seed})
         self.manager.begin()
         self._accuracy = self.manager.finish().accuracy

@@ -66,6 +66,8 @@ STRATEGIES: dict[str, Callable[..., Strategy]] = {
     "active-fs": ActiveFeatureSelectingStrategy,
 }
 STRATEGY_NAMES = tuple(STRATEGIES)
+# the strategy of the library's TeachingLoop, of EpisodeSettings, and of teach and demo, written once
+DEFAULT_STRATEGY = "dt-task"
 
 
 ACCEPTED = (f"{', '.join(STRATEGY_NAMES)}, {RL_PREFIX}FILE (a trained questioner policy .toml), or "
@@ -123,5 +125,6 @@ def file_label(name: str) -> str:
     return str(name)
 
 
-__all__ = ["ACCEPTED", "PLUGIN_FORM", "RL_PREFIX", "STRATEGIES", "STRATEGY_NAMES", "DecisionTheoreticStrategy",
+__all__ = ["ACCEPTED", "DEFAULT_STRATEGY", "PLUGIN_FORM", "RL_PREFIX", "STRATEGIES", "STRATEGY_NAMES",
+           "DecisionTheoreticStrategy",
            "Strategy", "check_strategy_name", "file_label", "is_external", "is_plugin_spec", "make_strategy"]

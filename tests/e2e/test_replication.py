@@ -106,3 +106,20 @@ def test_weights_that_can_never_ask_are_warned_about_in_one_line(tmp_path, capsy
     assert main(["regress", "--suite", "smoke", "--weights", f"zeros={path}", "--results", str(tmp_path / "r"),
                  "--no-progress"]) == 0
     assert sum("never asks" in line for line in capsys.readouterr().err.splitlines()) == 1
+
+
+def test_teach_takes_weights_with_the_expert_habit_features(tmp_path, capsys):
+    """What `learn-weights` writes by default since issue 27 names eleven features (the seven and the habits);
+    teach records them in the header and resumes from it (the header check once knew only the seven)."""
+    from pathlib import Path
+
+    shipped = Path(__file__).resolve().parents[2] / "learning" / "decision" / "presets" / "dt-task-env.toml"
+    path = tmp_path / "teach.jsonl"
+    assert main(["teach", "--weights", str(shipped), "--turns", "4", "--budget", "8", "--change-every", "2",
+                 "--transcript", str(path), "--teacher", "scripted", "--no-pictures", "--json"]) == 0
+    whole = last_json(capsys)
+    header = read_session(path)[0]
+    assert len(header["weights"]["values"]) == 11 and "pace_overrun" in header["weights"]["values"]
+    path.write_text("\n".join(path.read_text().splitlines()[:3]) + "\n")
+    assert main(["teach", "--resume", str(path), "--json"]) == 0
+    assert last_json(capsys)["accuracy"] == whole["accuracy"]
