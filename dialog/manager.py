@@ -31,11 +31,12 @@ from dialog.transcripts import records as checks
 from dialog.transcripts.jsonl import TranscriptWriter
 from dialog.transcripts.records import action_record, answer_record
 from dialog.transcripts.replay import replay_turn
-from learning.actions import Action, NoQuery
+from learning.actions import Action
 from learning.answers import DemoRow
 from learning.evaluation import accuracy
 from learning.state import LearningState
 from learning.strategies import Strategy
+from learning.turn import admissible, scene_epoch
 
 __all__ = ["DialogManager", "EpisodeConfig", "EpisodeResult", "episode_generators", "question_text"]
 
@@ -169,7 +170,7 @@ class DialogManager:
             epoch = int(start // self.embodied.scene_seconds(config.change_every))
         else:
             start = self.clock.now()
-            epoch = self.turn // config.change_every
+            epoch = scene_epoch(self.turn, config.change_every)
         due = self.scene is None or epoch > self._epoch
         if recorded_scene is not None:
             due = self.scene is None or recorded_scene != self.scene.scene_id
@@ -198,21 +199,6 @@ class DialogManager:
         """The arm now points at scene object ``index`` (None: it rested, e.g. after a fetch)."""
         self._last_pointed = index
 
-    def admissible(self, action: Action) -> tuple[Action, str]:
-        """The action itself if it may be taken now, else no query and the reason."""
-        state, scene = self.state, self.scene
-        if action.kind == "none":
-            return action, ""
-        if not state.can_afford(action):
-            return NoQuery(), f"Nothing to ask: the budget is spent ({state.spent:g} of {state.budget:g})."
-        if action.kind == "feature" and state.feature_query_asked:
-            return NoQuery(), "I already asked which features matter."
-        if action.kind == "label" and not 0 <= action.object_index < scene.n_objects:
-            return NoQuery(), f"There is no object {action.object_index + 1} in this scene."
-        if action.kind == "demo" and action.concept not in state.concepts:
-            return NoQuery(), f"'{action.concept}' is not a concept of this task."
-        return action, ""
-
     # -- one turn -----------------------------------------------------------------------
     def play_turn(self, action: Action | None = None, explanation: str = "") -> dict | None:
         """Choose (or take the given) action and realise it; None when the teacher quit."""
@@ -221,7 +207,7 @@ class DialogManager:
             decision = self.strategy.choose(self.state, self.rngs["strategy"])
             action, explanation = decision.action, decision.explanation
         chosen = action
-        action, reason = self.admissible(chosen)
+        action, reason = admissible(self.state, chosen)  # learning.turn: the library's rules
         return self.realise(action, reason or explanation, start, chosen)
 
     def realise(self, action: Action, explanation: str, start: float, chosen: Action | None = None) -> dict | None:

@@ -21,7 +21,7 @@ _EXPORTS = {
     "Query": "learning.loop",
     "Turn": "learning.loop",
     "CallOrderError": "learning.loop",
-    "admissible": "learning.loop",
+    "admissible": "learning.turn",
     "apply_answer": "learning.answers",
     "check_answer": "learning.answers",
     "Change": "learning.answers",

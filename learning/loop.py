@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from learning.actions import ACTION_KINDS, DEFAULT_COSTS, Action, NoQuery, validate_costs
+from learning.actions import ACTION_KINDS, DEFAULT_COSTS, Action, validate_costs
 from learning.answers import AnswerError, Change
 from learning.classifier import ConceptClassifier
 from learning.concepts import checked_rows, normalise_rows
@@ -23,6 +23,7 @@ from learning.errors import SettingsError, TeachbotError
 from learning.limits import check_limit, check_questions
 from learning.state import LearningState
 from learning.strategies import DEFAULT_STRATEGY, Strategy, make_strategy
+from learning.turn import admissible, scene_due, scene_epoch
 
 QUERY_KINDS = ACTION_KINDS
 
@@ -115,7 +116,8 @@ class TeachingLoop:
     def scene_due(self) -> bool:
         """True when the world should change before the next question: no scene yet, or a new block of
         ``change_every`` turns has begun since the last scene was observed."""
-        return self.scenes == 0 or self.turn // self.change_every > self._scene_turn // self.change_every
+        return scene_due(self.turn, self.change_every,
+                         None if self.scenes == 0 else scene_epoch(self._scene_turn, self.change_every))
 
     # -- one turn -----------------------------------------------------------------------
     def ask(self) -> Query:
@@ -221,21 +223,6 @@ class TeachingLoop:
     def pending(self) -> Query | None:
         """The question waiting for its answer, if any."""
         return None if self._pending is None else self._pending[1]
-
-
-def admissible(state: LearningState, action: Action) -> tuple[Action, str]:
-    """The action itself if it may be asked now, else no query and the reason."""
-    if action.kind == "none":
-        return action, ""
-    try:
-        state.check_action(action)
-    except ValueError as error:
-        return NoQuery(), f"Nothing to ask: {error}."
-    if not state.can_afford(action):
-        return NoQuery(), f"Nothing to ask: the budget is spent ({state.spent:g} of {state.budget:g})."
-    if action.kind == "feature" and state.feature_query_asked:
-        return NoQuery(), "Nothing to ask: I already asked which features matter."
-    return action, ""
 
 
 def _concept_names(concepts) -> tuple[tuple, tuple[str, ...]]:

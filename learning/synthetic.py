@@ -4,8 +4,8 @@ Each concept is a Gaussian blob in a few informative features; every other
 feature is noise, as most of the robot's ~90 features are for the thesis's
 tasks (§6.5.2). A scripted oracle answers label, demonstration and feature
 queries from the hidden truth. ``run_episode`` plays the same timed, budgeted
-loop as the dialog manager (a new scene every ``change_every`` turns), with
-plain arrays, so every strategy can be exercised without PyBullet.
+loop as the dialog manager and ``TeachingLoop`` (the turn rules of ``learning.turn``: a new scene every
+``change_every`` turns), with plain arrays, so every strategy can be exercised without PyBullet.
 """
 
 from __future__ import annotations
@@ -14,9 +14,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from learning.actions import Action, NoQuery
+from learning.actions import Action
 from learning.evaluation import accuracy
 from learning.state import LearningState
+from learning.turn import admissible, scene_due, scene_epoch
 
 DEFAULT_CONCEPTS = ("main dish", "snack", "fruit", "beverage")
 
@@ -83,12 +84,14 @@ def run_episode(strategy, task: SyntheticTask, rng: np.random.Generator, budget:
     actions, explanations = [], []
     X: np.ndarray  # both set at turn 0, the first scene
     truth: np.ndarray
+    last_scene = None
     for turn in range(turns):
-        if turn % change_every == 0:
+        if scene_due(turn, change_every, last_scene):  # learning.turn: the rules TeachingLoop and the dialog use
             X, truth = task.sample(objects, rng)
-            state.observe_scene(turn // change_every, X)
+            last_scene = scene_epoch(turn, change_every)
+            state.observe_scene(last_scene, X)
         decision = strategy.choose(state, rng)
-        action = decision.action if state.can_afford(decision.action) else NoQuery()
+        action, _ = admissible(state, decision.action)
         state.apply(action, task.answer(action, X, truth, rng))
         actions.append(action)
         explanations.append(decision.explanation)

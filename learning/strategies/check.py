@@ -20,9 +20,9 @@ import numpy as np
 
 from learning.actions import Decision, FeatureQuery, LabelQuery, NoQuery
 from learning.errors import SettingsError
-from learning.loop import admissible
 from learning.state import LearningState
 from learning.synthetic import SyntheticTask, random_state
+from learning.turn import admissible
 
 RULES = (
     "returns a Decision with a one-sentence explanation",
