@@ -19,8 +19,8 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from dialog.commands.learn_weights import git_commit  # noqa: E402
 from dialog.experiments.irl_rollouts import training_condition  # noqa: E402
+from dialog.experiments.provenance import git_commit  # noqa: E402
 from learning.decision.weights import WEIGHTS_DIRECTORY  # noqa: E402
 from learning.decision.weights_file import DecisionWeights, load_weights, save_weights  # noqa: E402
 from learning.irl.imitation import ablation_weights  # noqa: E402

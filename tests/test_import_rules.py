@@ -156,3 +156,23 @@ def test_the_default_strategy_is_written_once():
 
     assert DEFAULTS.strategy == teach_default == DEFAULT_STRATEGY == "dt-task"
     assert TeachingLoop(["a", "b"]).strategy.name == DEFAULT_STRATEGY
+
+
+def test_the_decision_rule_does_not_import_the_fit():
+    """learning/decision (the DT rule and its features and weights) is below learning/irl (fitting the weights):
+    irl reads decision features, never the other way round."""
+    upward = sorted(f"{module} -> {target}" for module, targets in import_graph().items()
+                    if module.startswith("learning.decision")
+                    for target in targets if target.startswith("learning.irl"))
+    assert upward == []
+
+
+def test_the_turn_rules_are_the_library_s():
+    """One implementation of a turn's rules (learning/turn.py): the library loop, the dialog manager and the
+    synthetic episodes import it, and no other module defines ``admissible``."""
+    graph = import_graph()
+    assert {"learning.loop", "dialog.manager", "learning.synthetic"} <= {m for m, t in graph.items()
+                                                                          if "learning.turn" in t}
+    defining = sorted(name for name, path in house_modules().items()
+                      if "def admissible(" in path.read_text(encoding="utf-8"))
+    assert defining == ["learning.turn"]

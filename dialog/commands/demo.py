@@ -17,12 +17,11 @@ from dialog.manager import episode_generators
 from dialog.output_paths import file_argument
 from dialog.settings import DEFAULTS, EpisodeSettings
 from dialog.teachers.scripted import OracleTeacher
-from dialog.transcripts.jsonl import FORMAT, TranscriptWriter
+from dialog.transcripts.jsonl import TranscriptWriter, refuse_foreign_transcript
 from dialog.transcripts.lock import TranscriptLock
 from dialog.user_weights import WEIGHTS_STRATEGY_NAME, add_weights_option, weights_strategy
 from dialog.viewer import DEFAULT_PACE_S, Pacer, add_viewer_option, hold_viewer, pace_of, viewer_observers
 from dialog.web.session import add_web_options, check_web_options
-from learning.errors import TranscriptError
 from learning.strategies import DEFAULT_STRATEGY, STRATEGY_NAMES
 
 SUMMARY_KEYS = ("seed", "strategy", "turns", "budget_spent", "queries", "accuracy", "transcript", "seconds")
@@ -47,25 +46,6 @@ def register(commands) -> None:
     add_web_options(parser, "watch the episode turn by turn")
     parser.add_argument("--json", action="store_true", help="end with one JSON line summarising the episode")
     parser.set_defaults(handler=run)
-
-
-def refuse_foreign_transcript(path: Path, lock: TranscriptLock) -> None:
-    """A demo rewrites only its own transcripts: a teach or expert session (research data) or any other file is
-    never overwritten."""
-    if lock.size() == 0:
-        return
-    with open(path, "rb") as handle:
-        first = handle.readline(1 << 16)
-    try:
-        header = json.loads(first).get("session")
-    except (ValueError, AttributeError):
-        header = None
-    if not isinstance(header, dict) or header.get("format") != FORMAT:
-        raise TranscriptError(f"{path} holds something other than a teachbot transcript; a demo does not overwrite "
-                              "it (choose another --transcript)")
-    if header.get("command", "demo") != "demo":
-        raise TranscriptError(f"{path} holds a recorded '{header['command']}' session; a demo does not overwrite it "
-                              "(choose another --transcript)")
 
 
 def default_transcript(args: argparse.Namespace, seconds: float | None) -> Path:
@@ -95,7 +75,7 @@ def run(args: argparse.Namespace) -> int:
     transcript_path = args.transcript or default_transcript(args, seconds)
     lock = TranscriptLock(transcript_path)  # checked and held before the kitchen is built: one writer per file
     try:
-        refuse_foreign_transcript(transcript_path, lock)
+        refuse_foreign_transcript(transcript_path, lock, "demo")
         environment = SimulatedKitchen(task=args.task, kitchen=args.kitchen, seed=args.seed,
                                        joint_speed=timing.joint_speed)
         pace = pace_of(args)

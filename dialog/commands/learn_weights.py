@@ -13,12 +13,11 @@ from __future__ import annotations
 
 import argparse
 import json
-import subprocess
 import sys
 import time
-from pathlib import Path
 
 from dialog.commands._arguments import positive_int, seed
+from dialog.experiments.provenance import git_commit
 from dialog.output_paths import check_writable, file_argument, make_parent, writing
 from dialog.user_weights import UserWeights
 from learning.errors import OutputPathError, SettingsError
@@ -27,7 +26,6 @@ from learning.errors import OutputPathError, SettingsError
 ROLLOUTS_PER_ITERATION = 6
 VALIDATION_EPISODES = 8
 EVALUATE_EVERY = 2
-REPOSITORY = Path(__file__).resolve().parents[2]
 
 
 def register(commands) -> None:
@@ -205,17 +203,6 @@ def learn_per_turn(args: argparse.Namespace, out):
           f"{provenance.get('validation_ask_or_quiet_agreement', float('nan')):.3f}, same kind of action: "
           f"{provenance.get('validation_action_kind_agreement', float('nan')):.3f})", file=out)
     return learned
-
-
-def git_commit() -> str:
-    """The repository's HEAD commit, or "unknown" outside a git checkout."""
-    try:
-        done = subprocess.run(["git", "rev-parse", "HEAD"], cwd=REPOSITORY, capture_output=True, text=True,
-                              timeout=10, check=False)
-    except (OSError, subprocess.SubprocessError):
-        return "unknown"
-    commit = done.stdout.strip()
-    return commit if done.returncode == 0 and len(commit) == 40 else "unknown"
 
 
 def learn_trajectory(args: argparse.Namespace, out):

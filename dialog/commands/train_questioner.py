@@ -55,7 +55,7 @@ def register(commands) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from dialog.commands.learn_weights import git_commit
+    from dialog.experiments.provenance import git_commit
     from dialog.rl.training import TrainingConfig, default_envs, require_rl, train
     from learning.rl.policy_file import save_policy
 

@@ -201,3 +201,22 @@ def read_session(path: str | Path, tolerate_partial_tail: bool = False) -> tuple
 def read_transcript(path: str | Path) -> list[dict]:
     """The turn records of a transcript (the session header is skipped)."""
     return read_session(path)[1]
+
+
+def refuse_foreign_transcript(path: Path, lock: TranscriptLock, command: str) -> None:
+    """A command that rewrites its transcript (``demo``) rewrites only its own: a teach or expert session
+    (research data) or any other file is never overwritten. ``lock`` is held on ``path``."""
+    if lock.size() == 0:
+        return
+    with open(path, "rb") as handle:
+        first = handle.readline(1 << 16)
+    try:
+        header = json.loads(first).get("session")
+    except (ValueError, AttributeError):
+        header = None
+    if not isinstance(header, dict) or header.get("format") != FORMAT:
+        raise TranscriptError(f"{path} holds something other than a teachbot transcript; a {command} does not "
+                              "overwrite it (choose another --transcript)")
+    if header.get("command", command) != command:
+        raise TranscriptError(f"{path} holds a recorded '{header['command']}' session; a {command} does not "
+                              "overwrite it (choose another --transcript)")

@@ -21,6 +21,8 @@ Choices the thesis leaves open, made here:
 
 from __future__ import annotations
 
+import re
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -201,3 +203,22 @@ def concept_counts(state) -> np.ndarray:
 def state_features(state, window_factor: float = 1.0) -> np.ndarray:
     """phi(s) of a LearningState as it is now (7,), in FEATURE_NAMES order."""
     return features(state.probabilities(), concept_counts(state), state_clock(state, window_factor))
+
+
+# a decision feature's name: a TOML bare key (weights files, demonstrations)
+FEATURE_NAME_PATTERN = re.compile(r"^[A-Za-z][A-Za-z0-9_-]*$")
+
+
+def check_feature_names(names: Sequence[str], source: str = "feature names") -> tuple[str, ...]:
+    """Decision-feature names: non-empty, distinct, letters/digits/_/- starting with a letter (TOML bare keys)."""
+    if isinstance(names, str) or not isinstance(names, Sequence) or len(names) == 0:
+        raise ValueError(f"{source}: expected a non-empty list of decision-feature names, got {names!r}")
+    names = tuple(names)
+    for name in names:
+        if not isinstance(name, str) or not FEATURE_NAME_PATTERN.match(name):
+            raise ValueError(f"{source}: feature name {name!r} is not accepted; use letters, digits, '_' or '-', "
+                             "starting with a letter")
+    if len(set(names)) != len(names):
+        duplicates = sorted({n for n in names if names.count(n) > 1})
+        raise ValueError(f"{source}: feature names must be distinct; repeated: {', '.join(duplicates)}")
+    return names

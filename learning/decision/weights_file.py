@@ -30,8 +30,8 @@ from pathlib import Path
 import numpy as np
 
 from learning.datafiles import read_toml
+from learning.decision.features import check_feature_names
 from learning.errors import DataFileError
-from learning.irl.demonstrations import check_feature_names
 from learning.limits import check_limit
 
 WEIGHTS_TABLE = "weights"

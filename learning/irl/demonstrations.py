@@ -24,7 +24,6 @@ refused otherwise, with a message saying how to record new ones.
 from __future__ import annotations
 
 import json
-import re
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -33,6 +32,7 @@ import numpy as np
 
 from learning.actions import ACTION_KINDS
 from learning.datafiles import MissingDataFileError
+from learning.decision.features import check_feature_names
 from learning.errors import DataFileError
 from learning.irl.format_upgrade import NotConvertible, upgrade_episodes
 
@@ -42,23 +42,7 @@ LEGACY_VERSIONS = (1,)  # read and converted on loading
 VERSION_KEY, LEGACY_VERSION_KEY = "format_version", "version"  # version 1 named its field "version"
 MAKE_NEW = "record new ones with scripts/make_expert_demos.py or `teachbot expert`"
 NO_QUERY_KIND = "none"
-FEATURE_NAME_PATTERN = re.compile(r"^[A-Za-z][A-Za-z0-9_-]*$")
 ACCEPTED_SUFFIXES = (".json", ".npz")
-
-
-def check_feature_names(names: Sequence[str], source: str = "feature names") -> tuple[str, ...]:
-    """Decision-feature names: non-empty, distinct, letters/digits/_/- starting with a letter (TOML bare keys)."""
-    if isinstance(names, str) or not isinstance(names, Sequence) or len(names) == 0:
-        raise ValueError(f"{source}: expected a non-empty list of decision-feature names, got {names!r}")
-    names = tuple(names)
-    for name in names:
-        if not isinstance(name, str) or not FEATURE_NAME_PATTERN.match(name):
-            raise ValueError(f"{source}: feature name {name!r} is not accepted; use letters, digits, '_' or '-', "
-                             "starting with a letter")
-    if len(set(names)) != len(names):
-        duplicates = sorted({n for n in names if names.count(n) > 1})
-        raise ValueError(f"{source}: feature names must be distinct; repeated: {', '.join(duplicates)}")
-    return names
 
 
 def _optional_strings(values, n_actions: int, what: str) -> tuple[str, ...] | None:
