@@ -25,6 +25,7 @@ import numpy as np
 from learning.datafiles import check_keys, number, numbers, read_toml, section, texts
 from learning.decision.embodied import SecondsClock
 from learning.errors import DataFileError
+from learning.strategies import TURNS_SUFFIX  # NAME+turns itself is decoded by make_strategy
 
 DATA = Path(__file__).resolve().parent / "data"
 COSTS_FILE = DATA / "embodied-costs.toml"
@@ -177,9 +178,6 @@ def load_embodied_costs(costs_path: str | Path = COSTS_FILE,
                          number(world, "turn_seconds", f"{where} [world]", above=0.0), onward)
 
 
-TURNS_SUFFIX = "+turns"  # a DT strategy that ignores embodied costs (time in turns), to compare with
-
-
 def is_turns_variant(name: str) -> bool:
     return str(name).endswith(TURNS_SUFFIX)
 
@@ -187,22 +185,6 @@ def is_turns_variant(name: str) -> bool:
 def strategy_names_with_variants(names) -> tuple[str, ...]:
     """The strategy names and, for every DT one, its ``NAME+turns`` variant (DT that ignores embodied costs)."""
     return (*names, *(f"{n}{TURNS_SUFFIX}" for n in names if str(n).startswith("dt")))
-
-
-def make_episode_strategy(name: str):
-    """``make_strategy(name)``, or for ``NAME+turns`` the DT strategy NAME reasoning in turns even in an episode
-    with embodied costs (remaining time in turns, no gain per second), called NAME+turns."""
-    from learning.errors import SettingsError
-    from learning.strategies import DecisionTheoreticStrategy, make_strategy
-
-    if not is_turns_variant(name):
-        return make_strategy(name)
-    base = str(name)[: -len(TURNS_SUFFIX)]
-    strategy = make_strategy(base)
-    if not isinstance(strategy, DecisionTheoreticStrategy):
-        raise SettingsError(f"'{name}': only a DT strategy has a {TURNS_SUFFIX} variant (it ignores embodied costs)")
-    strategy.embodied, strategy.name = False, str(name)
-    return strategy
 
 
 def default_allocation(path: str | Path = COSTS_FILE) -> float:

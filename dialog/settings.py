@@ -13,12 +13,11 @@ import math
 from dataclasses import dataclass, field
 from numbers import Integral, Real
 
-from dialog.embodied import make_episode_strategy
 from dialog.user_weights import weights_from_record
 from learning.actions import DEFAULT_COSTS
 from learning.errors import SettingsError
 from learning.limits import check_limit, check_questions
-from learning.strategies import DEFAULT_STRATEGY
+from learning.strategies import DEFAULT_STRATEGY, make_strategy
 
 __all__ = ["DEFAULTS", "EpisodeSettings", "check_allocation", "check_costs"]
 
@@ -96,7 +95,7 @@ class EpisodeSettings:
     def build_strategy(self):
         """The episode's strategy: the named one, or DT with the recorded user weights (shown as ``strategy``)."""
         if self.weights is None:
-            return make_episode_strategy(self.strategy)
+            return make_strategy(self.strategy)
         return weights_from_record(self.weights).strategy(self.strategy)
 
     def config(self, pictures: str | None = None):

@@ -68,6 +68,9 @@ STRATEGIES: dict[str, Callable[..., Strategy]] = {
 STRATEGY_NAMES = tuple(STRATEGIES)
 # the strategy of the library's TeachingLoop, of EpisodeSettings, and of teach and demo, written once
 DEFAULT_STRATEGY = "dt-task"
+# NAME+turns: the DT strategy NAME with time in turns (remaining time in turns, no gain per second) even in an
+# episode with embodied costs, to compare with NAME (thesis §8.2.2; docs/strategies.md)
+TURNS_SUFFIX = "+turns"
 
 
 ACCEPTED = (f"{', '.join(STRATEGY_NAMES)}, {RL_PREFIX}FILE (a trained questioner policy .toml), or "
@@ -75,12 +78,20 @@ ACCEPTED = (f"{', '.join(STRATEGY_NAMES)}, {RL_PREFIX}FILE (a trained questioner
 
 
 def make_strategy(name: str, **options) -> Strategy:
-    """The strategy called ``name``; a clear error lists the accepted names.
+    """The strategy called ``name``, every form of a name decoded here; a clear error lists the accepted names.
 
-    ``name`` is a registered name, ``rl:FILE`` or ``module.path:ClassName`` (imports and runs the user's code).
+    ``name`` is a registered name, ``NAME+turns`` (the DT strategy NAME reasoning in turns even in an episode
+    with embodied costs), ``rl:FILE`` or ``module.path:ClassName`` (imports and runs the user's code).
     Options go to the strategy's constructor, e.g. ``make_strategy("dt", weights={...}, engine="reference")``
     or ``make_strategy("all-cd", examples_per_concept=3)``.
     """
+    if str(name).endswith(TURNS_SUFFIX):
+        strategy = make_strategy(str(name)[: -len(TURNS_SUFFIX)], **options)
+        if not isinstance(strategy, DecisionTheoreticStrategy):
+            raise SettingsError(f"'{name}': only a DT strategy has a {TURNS_SUFFIX} variant (it ignores embodied "
+                                "costs)")
+        strategy.embodied, strategy.name = False, str(name)
+        return strategy
     if str(name).startswith(RL_PREFIX):  # a policy file: its path keeps its case
         return RLQuestionerStrategy(str(name)[len(RL_PREFIX):], name=str(name), **options)
     if is_plugin_spec(name):  # module.path:ClassName keeps its case too
@@ -125,6 +136,6 @@ def file_label(name: str) -> str:
     return str(name)
 
 
-__all__ = ["ACCEPTED", "DEFAULT_STRATEGY", "PLUGIN_FORM", "RL_PREFIX", "STRATEGIES", "STRATEGY_NAMES",
+__all__ = ["ACCEPTED", "DEFAULT_STRATEGY", "PLUGIN_FORM", "RL_PREFIX", "STRATEGIES", "STRATEGY_NAMES", "TURNS_SUFFIX",
            "DecisionTheoreticStrategy",
            "Strategy", "check_strategy_name", "file_label", "is_external", "is_plugin_spec", "make_strategy"]

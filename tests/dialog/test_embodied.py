@@ -12,12 +12,12 @@ from dialog.embodied import (
     DISTANCE,
     load_embodied_costs,
     load_pointing_model,
-    make_episode_strategy,
 )
 from dialog.manager import DialogManager, EpisodeConfig, episode_generators
 from dialog.teachers.scripted import ScriptedTeacher
 from dialog.transcripts.jsonl import TranscriptWriter, read_session, read_transcript
 from learning.errors import DataFileError, SettingsError
+from learning.strategies import make_strategy
 from tests.dialog.fakes import FakeEnvironment, QuittingTeacher
 
 
@@ -65,7 +65,7 @@ def embodied_run(tmp_path, name="t.jsonl", seconds=120.0, turns=200, strategy="d
         path, records = resume_from, read_session(resume_from, tolerate_partial_tail=True)[1]
     writer = TranscriptWriter(path, append=resume_from is not None)
     teacher = QuittingTeacher(inner, quit_at)
-    manager = DialogManager(RoomEnvironment(), teacher, make_episode_strategy(strategy), config, writer, rngs,
+    manager = DialogManager(RoomEnvironment(), teacher, make_strategy(strategy), config, writer, rngs,
                             say=lambda _: None, clock=clock)
     result = manager.run(replay=records)
     writer.close()
@@ -107,10 +107,10 @@ def test_an_embodied_session_resumes_to_the_same_transcript(tmp_path):
 
 
 def test_dt_in_turns_ignores_the_seconds(tmp_path):
-    strategy = make_episode_strategy("dt-task+turns")
+    strategy = make_strategy("dt-task+turns")
     assert strategy.name == "dt-task+turns" and strategy.embodied is False
     with pytest.raises(SettingsError, match="only a DT strategy"):
-        make_episode_strategy("active+turns")
+        make_strategy("active+turns")
     _, path, _ = embodied_run(tmp_path, strategy="dt-task+turns")
     assert not any("utility a second" in r["explanation"] for r in read_transcript(path))
 
