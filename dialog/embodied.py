@@ -178,10 +178,6 @@ def load_embodied_costs(costs_path: str | Path = COSTS_FILE,
                          number(world, "turn_seconds", f"{where} [world]", above=0.0), onward)
 
 
-def is_turns_variant(name: str) -> bool:
-    return str(name).endswith(TURNS_SUFFIX)
-
-
 def strategy_names_with_variants(names) -> tuple[str, ...]:
     """The strategy names and, for every DT one, its ``NAME+turns`` variant (DT that ignores embodied costs)."""
     return (*names, *(f"{n}{TURNS_SUFFIX}" for n in names if str(n).startswith("dt")))

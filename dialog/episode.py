@@ -2,8 +2,9 @@
 ``make_teacher`` builds a teacher of any kind, ``embodied_timing`` gives an allocation in seconds its clock.
 
 demo, teach, regress, study, expert, the Gymnasium environment and the scripts all call ``build_episode``,
-so the strategy name (a preset, ``NAME+turns``, ``rl:FILE``, ``module:Class``, or DT with a user's weights)
-is decoded once, by ``EpisodeSettings.build_strategy``, and the allocation comes from ``settings.config()``.
+so the strategy comes from ``EpisodeSettings.build_strategy`` (DT with a user's weights, else
+``learning.make_strategy``, which decodes every form of a name: a preset, ``NAME+turns``, ``rl:FILE``,
+``module:Class``) and the allocation from ``settings.config()``.
 The teachers live in ``dialog.teachers``; this module sits above them because a replay teacher reads a
 transcript (``dialog.transcripts``), which itself records the teachers' answers.
 """
