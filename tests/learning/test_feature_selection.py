@@ -393,3 +393,19 @@ def test_forward_search_on_rows_on_demand_equals_the_full_matrix_search(seed, si
     relevant = np.flatnonzero(class_su > 0)
     assert np.array_equal(LazyCorrelations(table).representatives(relevant),
                           _representatives(table.feature_su[np.ix_(relevant, relevant)]))
+
+
+def test_joint_entropies_from_the_count_lookup_equal_the_per_cell_formula_bit_for_bit():
+    """The -p log2 p lookup by count (issue 28) must give the very bits of computing every cell's term."""
+    from learning.features.information import DiscreteFeatures, _joint_entropies
+
+    for seed, n in enumerate((1, 2, 7, 150, 500)):
+        rng = np.random.default_rng(seed)
+        table = DiscreteFeatures(np.round(rng.normal(size=(n, 12)), 1), None)
+        block = table.one_hot[:, table.starts[3] : table.starts[3] + table.levels[3]]
+        counts = (block.T.astype(np.float32) @ table.one_hot32).astype(np.float64)
+        probabilities = counts / n
+        terms = -(probabilities * np.log2(np.where(probabilities > 0, probabilities, 1.0))).sum(axis=0)
+        joint, cells = _joint_entropies(block, table.one_hot32, table.starts)
+        np.testing.assert_array_equal(joint, np.add.reduceat(terms, table.starts))
+        np.testing.assert_array_equal(cells, np.add.reduceat((counts > 0).sum(axis=0), table.starts))
