@@ -12,7 +12,10 @@ Timing: the decision only (expected decision features of every candidate +
 argmax); the learner's current p(y|x) is part of the state and computed
 before the clock starts. Each fast timing is the best of ``--repeats`` cold
 runs (the state's cache cleared before each); the reference is timed once.
-BLAS runs on one thread unless ``--threads`` says otherwise. ``fast_ms`` and
+BLAS runs on one thread unless ``--threads`` says otherwise. The CPU times are
+also split by whether the feature query is still open (``fast_cpu_ms_fsq_closed``
+and ``_open``), and on the open states ES alone, the teacher's simulated answer
+F_{y,c} (``es_cpu_ms``, best of as many cold runs): the floors of a decision. ``fast_ms`` and
 ``reference_ms`` are wall-clock; ``fast_cpu_ms`` and ``reference_cpu_ms`` are
 this process's CPU time for the same runs, which other programs on a busy
 machine do not inflate (``speedup_cpu`` compares those); the load average at
@@ -64,6 +67,7 @@ from learning.decision.candidates import expected_decision_features  # noqa: E40
 from learning.decision.weights import resolve_weights  # noqa: E402
 from learning.strategies.decision_theoretic import choose_index  # noqa: E402
 from learning.synthetic import SyntheticTask, random_state  # noqa: E402
+from learning.whatif.base import feature_query_subsets  # noqa: E402
 
 LARGE_TRAINING_SET = 500
 
@@ -94,6 +98,8 @@ def measure_size(n_objects: int, n_train: int, args, weights: np.ndarray) -> dic
     with_reference = args.states if n_train < LARGE_TRAINING_SET else min(args.states, args.reference_states_large)
     fast_ms, fast_cpu_ms, reference_ms, reference_cpu_ms = [], [], [], []
     same, regrets, eu_errors, open_fsq, states_seen = [], [], [], 0, []
+    by_fsq: dict[bool, list[float]] = {True: [], False: []}
+    es_cpu_ms = []
     for index in range(args.states):
         state = random_state(task, n_train, n_objects, rng, feature_query_answered=bool(rng.random() < 0.5))
         state.probabilities()  # the learner's current beliefs belong to the state, not to the decision
@@ -108,6 +114,9 @@ def measure_size(n_objects: int, n_train: int, args, weights: np.ndarray) -> dic
             best_cpu = min(best_cpu, time.process_time() - started_cpu)
         fast_ms.append(1e3 * best)
         fast_cpu_ms.append(1e3 * best_cpu)
+        by_fsq[not state.feature_query_asked].append(1e3 * best_cpu)
+        if not state.feature_query_asked:
+            es_cpu_ms.append(1e3 * _best_cpu_seconds(lambda s=state: feature_query_subsets(s), args.repeats))
         if index >= with_reference:
             continue
         started, started_cpu = time.perf_counter(), time.process_time()
@@ -135,9 +144,36 @@ def measure_size(n_objects: int, n_train: int, args, weights: np.ndarray) -> dic
         "same_action": round(float(np.mean(same)), 4),
         "max_regret": float(f"{max(regrets):.3g}"),
         "max_eu_error": float(f"{max(eu_errors):.3g}"),
+        "fast_cpu_ms_fsq_closed": _percentiles(by_fsq[False]), "fast_cpu_ms_fsq_open": _percentiles(by_fsq[True]),
+        "es_cpu_ms": _percentiles(es_cpu_ms),
         "states": args.states, "reference_states": with_reference, "feature_query_open": open_fsq,
         "load_average": round(os.getloadavg()[0], 2),
     }
+
+
+def _best_cpu_seconds(run, repeats: int) -> float:
+    best = np.inf
+    for _ in range(repeats):
+        started = time.process_time()
+        run()
+        best = min(best, time.process_time() - started)
+    return best
+
+
+def _percentiles(values: list[float]) -> dict | None:
+    """p50 and p95 in ms, or None when no state fell in the group."""
+    if not values:
+        return None
+    return {"p50": round(float(np.percentile(values, 50)), 2), "p95": round(float(np.percentile(values, 95)), 2)}
+
+
+def _split_line(row: dict) -> str:
+    parts = []
+    for label, key in (("FSQ closed", "fast_cpu_ms_fsq_closed"), ("FSQ open", "fast_cpu_ms_fsq_open"),
+                       ("ES alone", "es_cpu_ms")):
+        value = row[key]
+        parts.append(f"{label} " + ("-" if value is None else f"p50 {value['p50']:.2f} p95 {value['p95']:.2f} ms"))
+    return "           cpu by state: " + "; ".join(parts)
 
 
 def main(args) -> int:
@@ -158,6 +194,7 @@ def main(args) -> int:
                   f"{row['max_regret']:>10.2g} "
                   f"{row['max_eu_error']:>10.2g} | {row['states']} ({row['reference_states']}) | "
                   f"{row['load_average']:.1f}", flush=True)
+            print(_split_line(row), flush=True)
     if args.json:
         print(json.dumps(results))
     return 0
