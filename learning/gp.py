@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy.linalg import cho_factor, cho_solve, cholesky, solve_triangular
-from scipy.linalg.lapack import dpotrf
+from scipy.linalg.lapack import spotrf, spotrs, strtrs
 
 
 def rbf_kernel(A: np.ndarray, B: np.ndarray, length_scale: float, variance: float) -> np.ndarray:
@@ -85,7 +85,7 @@ class BinaryGPClassifier:
                 and np.array_equal(previous.X_train_, self.X_train_[:n_old]))
 
     def _extend(self, previous: BinaryGPClassifier, K: np.ndarray, t: np.ndarray):
-        """The mode after appending sites to ``previous``'s fit, in O(n^2) per step, then its exact factor.
+        """The mode after appending sites to ``previous``'s fit, in O(n^2) per step, then the factor at the mode.
 
         Start: the old sites at the old mode (a = its gradient) and each new site at its predictive mean
         given them (f = K a). Chord Newton steps a <- a + (I + W0 K)^-1 (grad - a) solve with the old
@@ -141,8 +141,7 @@ class BinaryGPClassifier:
             f = f_new
         pi = sigmoid(f)
         sw = np.sqrt(pi * (1 - pi))
-        L = cho_factor(np.eye(n) + sw[:, None] * K * sw[None, :], lower=True)
-        return f, sw, L
+        return f, sw, mode_factor(K, sw)
 
     def latent(self, X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Predictive mean and variance of the latent function (R&W algorithm 3.2)."""
@@ -151,8 +150,9 @@ class BinaryGPClassifier:
             return np.zeros(len(X)), np.full(len(X), self.variance)
         Ks = rbf_kernel(self.X_train_, X, self.length_scale_, self.variance)
         mean = Ks.T @ self.grad_
-        v = cho_solve(self.L_, self.W_sqrt_[:, None] * Ks)
-        var = self.variance - np.sum((self.W_sqrt_[:, None] * Ks) * v, axis=0)
+        right = self.W_sqrt_[:, None] * Ks
+        v = factor_solve(self.L_[0], right.astype(np.float32))  # B^-1 S K_ns (float32: see mode_factor)
+        var = self.variance - np.sum(right * v, axis=0)
         return mean, np.maximum(var, 1e-12)
 
     def predict_proba(self, X: np.ndarray) -> np.ndarray:
@@ -197,30 +197,56 @@ class BorderedFactor:
     def of(cls, L_old: np.ndarray, K: np.ndarray, sw: np.ndarray) -> BorderedFactor:
         n_old = len(L_old)
         s_old, s_new = sw[:n_old], sw[n_old:]
-        border = solve_triangular(L_old, s_old[:, None] * K[:n_old, n_old:] * s_new[None, :], lower=True,
-                                  check_finite=False)
+        right = (s_old[:, None] * K[:n_old, n_old:] * s_new[None, :]).astype(np.float32)
+        border = triangular_solve(L_old, right, lower=True, trans=0).astype(float)
         corner = np.eye(len(s_new)) + s_new[:, None] * K[n_old:, n_old:] * s_new[None, :] - border.T @ border
         return cls(L_old, border, cholesky(corner, lower=True, check_finite=False))
 
     def solve(self, b: np.ndarray) -> np.ndarray:
-        """(L L^T)^-1 b, forward then back substitution by blocks."""
+        """(L L^T)^-1 b, forward then back substitution by blocks (the old block in float32: a preconditioner)."""
         n_old = len(self.old)
-        top = solve_triangular(self.old, b[:n_old], lower=True, check_finite=False)
+        top = triangular_solve(self.old, b[:n_old].astype(np.float32), lower=True, trans=0).astype(float)
         bottom = solve_triangular(self.corner, b[n_old:] - self.border.T @ top, lower=True, check_finite=False)
         bottom = solve_triangular(self.corner, bottom, lower=True, trans="T", check_finite=False)
-        top = solve_triangular(self.old, top - self.border @ bottom, lower=True, trans="T", check_finite=False)
-        return np.concatenate([top, bottom])
+        top = triangular_solve(self.old, (top - self.border @ bottom).astype(np.float32), lower=True, trans=1)
+        return np.concatenate([top.astype(float), bottom])
 
 
 def mode_factor(K: np.ndarray, sw: np.ndarray) -> tuple[np.ndarray, bool]:
-    """``cho_factor(I + S K S, lower=True)`` built in place, one n x n array (S = diag(sw))."""
-    B = sw[:, None] * K
-    B *= sw[None, :]
+    """The lower Cholesky factor of B = I + S K S at the mode (S = diag(sw)), in float32, as (factor, True).
+
+    B's eigenvalues are >= 1 and at most 1 + n max(W) variance, so single precision moves the predictive
+    probabilities by ~1e-8 (tests/learning/test_gp.py), far inside the Newton tolerance, and LAPACK's
+    float32 factorisation takes about half the time: it is the O(n^3) step of every refit.
+    """
+    B = np.empty(K.shape, dtype=np.float32)
+    np.multiply(K, sw[:, None], out=B, casting="same_kind")
+    B *= sw.astype(np.float32)[None, :]
     B.flat[:: len(sw) + 1] += 1.0
-    factor, info = dpotrf(B.T, lower=1, clean=0, overwrite_a=1)  # B.T: the same symmetric matrix, Fortran order
+    factor, info = spotrf(B.T, lower=1, clean=0, overwrite_a=1)  # B.T: the same symmetric matrix, Fortran order
     if info != 0:
-        raise np.linalg.LinAlgError(f"I + S K S is not positive definite (LAPACK dpotrf info {info})")
+        raise np.linalg.LinAlgError(f"I + S K S is not positive definite (LAPACK spotrf info {info})")
     return factor, True
+
+
+def factor_solve(factor: np.ndarray, right: np.ndarray) -> np.ndarray:
+    """B^-1 right from ``mode_factor``'s float32 lower factor (LAPACK spotrs), as float64."""
+    solved, info = spotrs(factor, right, lower=1)
+    if info != 0:
+        raise np.linalg.LinAlgError(f"Cholesky solve failed (LAPACK spotrs info {info})")
+    return solved.astype(float)
+
+
+def triangular_solve(factor: np.ndarray, right: np.ndarray, lower: bool, trans: int) -> np.ndarray:
+    """``scipy.linalg.solve_triangular(factor, right, lower, trans)`` for a float32 factor: the same LAPACK call
+    (strtrs, on the factor or on its transpose, as scipy picks by memory order), without the wrapper's checks."""
+    if factor.flags.f_contiguous:
+        solved, info = strtrs(factor, right, lower=lower, trans=trans)
+    else:
+        solved, info = strtrs(factor.T, right, lower=not lower, trans=1 - trans)
+    if info != 0:
+        raise np.linalg.LinAlgError(f"triangular solve failed (LAPACK strtrs info {info})")
+    return solved
 
 
 def sigmoid(z: np.ndarray) -> np.ndarray:

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.linalg.lapack import spotrf, spotrs, strtrs
 
-from learning.gp import BinaryGPClassifier, rbf_kernel, sigmoid
+from learning.gp import BinaryGPClassifier, rbf_kernel, sigmoid, triangular_solve
 
 MIN_VARIANCE = 1e-12
 MIN_SITE_SCALE = 1e-6  # W^1/2 below this: too small to divide by
@@ -88,9 +88,9 @@ def scene_posterior(model: BinaryGPClassifier, scene: np.ndarray, kernels: tuple
         return ScenePosterior(np.zeros(len(scene)), K_ss)
     factor, lower = model.L_
     sw = model.W_sqrt_
-    factor32 = factor.astype(np.float32)  # B's eigenvalues are >= 1: single precision loses ~1e-7
-    V32 = _triangular_solve(factor32, (sw[:, None] * K_ns).astype(np.float32), lower, 0)
-    solved = _triangular_solve(factor32, V32, lower, 1).astype(float)  # B^-1 S K_ns
+    factor32 = np.asarray(factor, dtype=np.float32)  # the model's factor is float32 already (gp.mode_factor)
+    V32 = triangular_solve(factor32, (sw[:, None] * K_ns).astype(np.float32), lower, 0)
+    solved = triangular_solve(factor32, V32, lower, 1).astype(float)  # B^-1 S K_ns
     V = V32.astype(float)
     cross = solved / np.maximum(sw, MIN_SITE_SCALE)[:, None]
     tiny = np.flatnonzero(sw < MIN_SITE_SCALE)
@@ -98,18 +98,6 @@ def scene_posterior(model: BinaryGPClassifier, scene: np.ndarray, kernels: tuple
         K_tn = rbf_kernel(X[tiny], X, model.length_scale_, model.variance)
         cross[tiny] = K_ns[tiny] - K_tn @ (sw[:, None] * solved)
     return ScenePosterior(K_ns.T @ model.grad_, K_ss - V.T @ V, cross, model.f_hat_, sw * sw)
-
-
-def _triangular_solve(factor: np.ndarray, right: np.ndarray, lower: bool, trans: int) -> np.ndarray:
-    """``scipy.linalg.solve_triangular(factor, right, lower, trans)`` for a float32 factor: the same LAPACK call
-    (strtrs, on the factor or on its transpose, as scipy picks by memory order), without the wrapper's checks."""
-    if factor.flags.f_contiguous:
-        solved, info = strtrs(factor, right, lower=lower, trans=trans)
-    else:
-        solved, info = strtrs(factor.T, right, lower=not lower, trans=1 - trans)
-    if info != 0:
-        raise np.linalg.LinAlgError(f"triangular solve failed (LAPACK strtrs info {info})")
-    return solved
 
 
 def stack_posteriors(posteriors: list[ScenePosterior]) -> ScenePosterior:

@@ -70,3 +70,25 @@ def test_a_feature_constant_so_far_does_not_swamp_the_others():
     assert abs(z[0, 0]) < 1e-9
     assert abs(z[0, 1]) < 0.1  # was 1e4 with an absolute 1e-6 floor
     assert np.allclose(scaler.std[0], np.sqrt(2 / 3))
+
+
+@pytest.mark.parametrize("columns", [slice(None), [0, 1], [0]])
+def test_the_float32_factor_at_the_mode_predicts_what_double_precision_does(columns):
+    """``mode_factor`` is single precision: the predictive probabilities of R&W algorithm 3.2 with a float64
+    factor of the same B may differ by far less than the Newton tolerance (1e-6); measured ~1e-8."""
+    from learning.gp import rbf_kernel, sigmoid
+    from learning.synthetic import SyntheticTask
+
+    task = SyntheticTask(seed=5)
+    X, labels = task.sample(400, np.random.default_rng(5))
+    X = ((X - X.mean(axis=0)) / X.std(axis=0))[:, columns]
+    train, held_out, y = X[:300], X[300:], labels[:300] == "fruit"
+    model = BinaryGPClassifier().fit(train, y)
+    assert model.L_[0].dtype == np.float32
+    sw = model.W_sqrt_
+    L64 = np.linalg.cholesky(np.eye(len(sw)) + sw[:, None] * model.K_ * sw[None, :])
+    Ks = rbf_kernel(train, held_out, model.length_scale_, model.variance)
+    v = np.linalg.solve(L64, sw[:, None] * Ks)
+    var = model.variance - np.sum(v * v, axis=0)
+    double = sigmoid((Ks.T @ model.grad_) / np.sqrt(1.0 + np.pi * var / 8.0))
+    assert np.max(np.abs(model.predict_proba(held_out) - double)) < 1e-7

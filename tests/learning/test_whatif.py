@@ -145,11 +145,12 @@ def test_unknown_engine_is_a_clear_error():
 
 
 def test_the_in_place_arithmetic_gives_the_same_bits_as_the_plain_formulas():
-    """``_probit_in_place`` is ``probit_probability`` and ``_triangular_solve`` is scipy's solve_triangular,
+    """``_probit_in_place`` is ``probit_probability`` and ``gp.triangular_solve`` is scipy's solve_triangular,
     to the bit (the decision's tables, and so every transcript, rest on it)."""
     from scipy.linalg import solve_triangular
 
-    from learning.whatif.laplace import _probit_in_place, _triangular_solve, probit_probability
+    from learning.gp import triangular_solve
+    from learning.whatif.laplace import _probit_in_place, probit_probability
 
     rng = np.random.default_rng(3)
     mean, variance = rng.normal(size=(2, 3, 7, 7)) * 4.0, rng.normal(size=(2, 3, 7, 7)) ** 2
@@ -162,7 +163,7 @@ def test_the_in_place_arithmetic_gives_the_same_bits_as_the_plain_formulas():
     for matrix in (factor, np.asfortranarray(factor)):
         for lower, trans in ((True, 0), (True, 1)):
             plain = solve_triangular(matrix, right, lower=lower, trans=trans, check_finite=False)
-            assert np.array_equal(_triangular_solve(matrix, right, lower, trans), plain)
+            assert np.array_equal(triangular_solve(matrix, right, lower, trans), plain)
     for matrix in (factor.T, np.asfortranarray(factor.T)):  # an upper factor
-        assert np.array_equal(_triangular_solve(matrix, right, False, 0),
+        assert np.array_equal(triangular_solve(matrix, right, False, 0),
                               solve_triangular(matrix, right, lower=False, check_finite=False))
