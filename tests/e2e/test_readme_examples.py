@@ -4,9 +4,11 @@ Commands are taken from the README's code blocks and inline code spans; a few ar
 reason given in SKIPPED, which must name only commands the README still shows.
 """
 
+import os
 import re
 import shlex
 import shutil
+import signal
 import subprocess
 import sys
 from pathlib import Path
@@ -84,7 +86,45 @@ def test_a_readme_example_runs_as_written(command, tmp_path):
             (tmp_path / name).parent.mkdir(parents=True, exist_ok=True)
             for part in (source, source.with_suffix(".npz")) if argument.startswith("rl:") else (source,):
                 shutil.copy(part, tmp_path / Path(name).with_suffix(part.suffix))
-    result = subprocess.run(argv, cwd=tmp_path, capture_output=True, text=True, timeout=TIMEOUT_S,
-                            stdin=subprocess.DEVNULL, check=False)
-    assert result.returncode == 0, f"{command} exited {result.returncode}:\n{result.stderr[-2000:]}"
-    assert "Traceback" not in result.stderr
+    returncode, stderr = run_in_own_group(argv, tmp_path)
+    assert returncode == 0, f"{command} exited {returncode}:\n{stderr[-2000:]}"
+    assert "Traceback" not in stderr
+
+
+def run_in_own_group(argv: list[str], cwd: Path) -> tuple[int, str]:
+    """Run ``argv`` in its own process group; past ``TIMEOUT_S`` the whole group is killed and the test fails,
+    so worker processes (``teachbot regress`` starts one per core) do not outlive it."""
+    process = subprocess.Popen(argv, cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                               stdin=subprocess.DEVNULL, start_new_session=True)
+    try:
+        _, stderr = process.communicate(timeout=TIMEOUT_S)
+    except subprocess.TimeoutExpired:
+        os.killpg(process.pid, signal.SIGKILL)
+        process.communicate()
+        pytest.fail(f"{shlex.join(argv[1:])} did not finish within {TIMEOUT_S} s (its process group was killed)")
+    return process.returncode, stderr
+
+
+def test_a_command_past_its_time_is_killed_with_every_process_it_started(tmp_path, monkeypatch):
+    """The timeout kills the example's whole process group: a child it started (as regress starts workers)
+    does not keep running after the test."""
+    import time
+
+    monkeypatch.setattr(sys.modules[__name__], "TIMEOUT_S", 2)
+    pid_file = tmp_path / "child.pid"
+    script = ("import subprocess, sys, time; "
+              "child = subprocess.Popen([sys.executable, '-c', 'import time; time.sleep(120)']); "
+              f"open({str(pid_file)!r}, 'w').write(str(child.pid)); child.wait()")
+    with pytest.raises(pytest.fail.Exception, match="did not finish within 2 s"):
+        run_in_own_group([sys.executable, "-c", script], tmp_path)
+    child = int(pid_file.read_text())
+    deadline = time.monotonic() + 10
+    while time.monotonic() < deadline:
+        try:
+            if "\nState:\tZ" in Path(f"/proc/{child}/status").read_text():
+                break  # killed, waiting for init to reap it
+        except FileNotFoundError:
+            break  # killed and reaped
+        time.sleep(0.1)
+    else:
+        pytest.fail(f"the example's child process {child} outlived the timeout")
