@@ -8,7 +8,7 @@ answer, and is learned twice, each from the same n - 1 fit:
 
 * incremental: ``fit(X, y, previous=...)``, the old kernel block reused and
   Newton started from the old mode (chord steps with the old factor bordered
-  by the new row, then the exact factor at the new mode), forced at every n
+  by the new row, then the single-precision factor at the new mode), forced at every n
   (``incremental_from=1``) so the rows show the update itself;
 * fresh: ``fit(X, y)`` from scratch, what every refit did before.
 
