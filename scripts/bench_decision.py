@@ -16,7 +16,10 @@ BLAS runs on one thread unless ``--threads`` says otherwise. The CPU times are
 also split by whether the feature query is still open (``fast_cpu_ms_fsq_closed``
 and ``_open``), and on the open states ES alone, the teacher's simulated answer
 F_{y,c}, is timed too (``es_cpu_ms``, best of as many cold runs): the floors of
-a decision. ``fast_ms`` and ``reference_ms`` are wall-clock; ``fast_cpu_ms`` and ``reference_cpu_ms`` are
+a decision. One more cold run per state, not timed as a whole, adds up the CPU time spent inside the
+LAPACK calls the engine makes (``lapack_cpu_ms_fsq_closed`` / ``_open``, f2py's wrapper included; see
+``lapack_timer``): what a compiled port of the same algorithm would still pay.
+``fast_ms`` and ``reference_ms`` are wall-clock; ``fast_cpu_ms`` and ``reference_cpu_ms`` are
 this process's CPU time for the same runs, which other programs on a busy
 machine do not inflate (``speedup_cpu`` compares those); the load average at
 the start and end is printed and reported.
@@ -60,6 +63,7 @@ if ARGS is not None:  # BLAS reads these once, when numpy is first imported
 
 import json  # noqa: E402
 import time  # noqa: E402
+from contextlib import contextmanager  # noqa: E402
 
 import numpy as np  # noqa: E402
 
@@ -76,6 +80,41 @@ def decide(state, engine: str, weights: np.ndarray):
     candidates = expected_decision_features(state, engine)
     utilities = candidates.utilities(weights)
     return candidates, utilities, choose_index(utilities)
+
+
+@contextmanager
+def lapack_timer():
+    """Add up the CPU seconds spent inside the what-if engine's LAPACK calls while the block runs.
+
+    Yields a one-element list holding the running total. The engine's factorisations and solves are
+    ``spotrf``, ``spotrs`` and ``strtrs`` (``learning.whatif.laplace``, ``learning.gp``) and the small
+    batched ``numpy.linalg.solve`` of the weight-space Newton; each name is wrapped for the block only.
+    Matrix products and elementwise work are not counted: this is a lower bound on a compiled port's time.
+    """
+    import learning.gp as gp
+    import learning.whatif.laplace as laplace
+
+    total = [0.0]
+    targets = [(module, name) for module in (gp, laplace) for name in ("spotrf", "spotrs", "strtrs")]
+    targets.append((np.linalg, "solve"))
+    originals = [getattr(module, name) for module, name in targets]
+
+    def timed(function):
+        def call(*args, **kwargs):
+            started = time.process_time()
+            try:
+                return function(*args, **kwargs)
+            finally:
+                total[0] += time.process_time() - started
+        return call
+
+    for (module, name), original in zip(targets, originals):
+        setattr(module, name, timed(original))
+    try:
+        yield total
+    finally:
+        for (module, name), original in zip(targets, originals):
+            setattr(module, name, original)
 
 
 def print_profile(states, weights: np.ndarray, top: int) -> None:
@@ -100,6 +139,7 @@ def measure_size(n_objects: int, n_train: int, args, weights: np.ndarray) -> dic
     same, regrets, eu_errors, states_seen = [], [], [], []
     by_fsq: dict[bool, list[float]] = {True: [], False: []}
     es_cpu_ms = []
+    lapack_ms: dict[bool, list[float]] = {True: [], False: []}
     for index in range(args.states):
         state = random_state(task, n_train, n_objects, rng, feature_query_answered=bool(rng.random() < 0.5))
         state.probabilities()  # the learner's current beliefs belong to the state, not to the decision
@@ -114,6 +154,10 @@ def measure_size(n_objects: int, n_train: int, args, weights: np.ndarray) -> dic
         fast_ms.append(1e3 * best)
         fast_cpu_ms.append(1e3 * best_cpu)
         by_fsq[not state.feature_query_asked].append(1e3 * best_cpu)
+        state.cache.clear()
+        with lapack_timer() as inside:
+            decide(state, "fast", weights)
+        lapack_ms[not state.feature_query_asked].append(1e3 * inside[0])
         if not state.feature_query_asked:
             es_cpu_ms.append(1e3 * _best_cpu_seconds(lambda s=state: feature_query_subsets(s), args.repeats))
         if index >= with_reference:
@@ -145,6 +189,8 @@ def measure_size(n_objects: int, n_train: int, args, weights: np.ndarray) -> dic
         "max_eu_error": float(f"{max(eu_errors):.3g}"),
         "fast_cpu_ms_fsq_closed": _percentiles(by_fsq[False]), "fast_cpu_ms_fsq_open": _percentiles(by_fsq[True]),
         "es_cpu_ms": _percentiles(es_cpu_ms),
+        "lapack_cpu_ms_fsq_closed": _percentiles(lapack_ms[False]),
+        "lapack_cpu_ms_fsq_open": _percentiles(lapack_ms[True]),
         "states": args.states, "reference_states": with_reference, "feature_query_open": len(by_fsq[True]),
         "load_average": round(os.getloadavg()[0], 2),
     }
@@ -167,12 +213,15 @@ def _percentiles(values: list[float]) -> dict | None:
 
 
 def _split_line(row: dict) -> str:
-    parts = []
-    for label, key in (("FSQ closed", "fast_cpu_ms_fsq_closed"), ("FSQ open", "fast_cpu_ms_fsq_open"),
-                       ("ES alone", "es_cpu_ms")):
-        value = row[key]
-        parts.append(f"{label} " + ("-" if value is None else f"p50 {value['p50']:.2f} p95 {value['p95']:.2f} ms"))
-    return "           cpu by state: " + "; ".join(parts)
+    """Two lines: the CPU time by whether the feature query is open, with ES alone, then the part inside LAPACK."""
+    def groups(pairs) -> str:
+        return "; ".join(f"{label} " + ("-" if row[key] is None else
+                                       f"p50 {row[key]['p50']:.2f} p95 {row[key]['p95']:.2f} ms")
+                         for label, key in pairs)
+    by_state = groups((("FSQ closed", "fast_cpu_ms_fsq_closed"), ("FSQ open", "fast_cpu_ms_fsq_open"),
+                       ("ES alone", "es_cpu_ms")))
+    inside = groups((("FSQ closed", "lapack_cpu_ms_fsq_closed"), ("FSQ open", "lapack_cpu_ms_fsq_open")))
+    return f"           cpu by state: {by_state}\n           inside LAPACK: {inside}"
 
 
 def main(args) -> int:
