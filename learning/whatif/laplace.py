@@ -24,7 +24,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.linalg.lapack import spotrf, spotrs, strtrs
+from scipy.linalg.lapack import spotrf, spotrs
 
 from learning.gp import BinaryGPClassifier, rbf_kernel, sigmoid, triangular_solve
 
@@ -288,7 +288,7 @@ def predict_from_modes(cross_kernels: np.ndarray, variance: float, sw: np.ndarra
     K_ns = cross_kernels[kernel_of_row]
     mean = np.matmul(gradient[:, None, :], K_ns)[:, 0, :]
     right = sw.astype(np.float32)[:, :, None] * K_ns.astype(np.float32)
-    V = np.array([strtrs(factor.T, r, lower=1)[0] for factor, r in zip(factors, right)])
+    V = np.array([triangular_solve(factor.T, r, lower=True, trans=0) for factor, r in zip(factors, right)])
     latent_variance = variance - np.einsum("bij,bij->bj", V, V, dtype=np.float64)
     return probit_probability(mean, latent_variance)
 
