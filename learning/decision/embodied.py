@@ -22,6 +22,8 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from learning.decision.resolution import first_of_best
+
 KINDS = ("label", "demo", "feature", "none")
 
 
@@ -88,9 +90,10 @@ def choose_per_second(utilities: np.ndarray, seconds: np.ndarray, tolerance: flo
 
     Gain(a) = EU(a) - EU(no query), both at their own next states (eq. 7.1). Among the queries with a gain
     above ``tolerance`` x max(1, |EU(no query)|), take the one with the largest gain per expected second,
-    Gain(a) / E[seconds(a)]; ties go to the first in candidate order. No query when none gains. So a query
-    is still asked only when it beats staying quiet (as without embodied costs), and of two equally useful
-    questions the quicker one is asked: a near object before a far one.
+    Gain(a) / E[seconds(a)]; rates within a relative ``tolerance`` of the largest are a tie, which goes to
+    the first in candidate order. No query when none gains. So a query is still asked only when it beats
+    staying quiet (as without embodied costs), and of two equally useful questions the quicker one is asked:
+    a near object before a far one.
     """
     utilities, seconds = np.asarray(utilities, dtype=float), np.asarray(seconds, dtype=float)
     stay = utilities[-1]
@@ -99,4 +102,4 @@ def choose_per_second(utilities: np.ndarray, seconds: np.ndarray, tolerance: flo
     if not worth.any():
         return len(utilities) - 1
     rate = np.where(worth, gains / np.maximum(seconds[:-1], 1e-9), -np.inf)
-    return int(np.argmax(rate))
+    return first_of_best(rate, tolerance * float(rate.max()))

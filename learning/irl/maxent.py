@@ -34,6 +34,7 @@ import torch.nn.functional as F
 from scipy.optimize import minimize
 from threadpoolctl import threadpool_limits
 
+from learning.decision.resolution import EU_RESOLUTION
 from learning.decision.weights_file import DecisionWeights
 from learning.irl.demonstrations import QuestioningEpisode, common_feature_names
 
@@ -99,7 +100,7 @@ class PaddedTurns:
     def __len__(self) -> int:
         return len(self.chosen)
 
-    def choices(self, weights: np.ndarray, rtol: float = 1e-9) -> np.ndarray:
+    def choices(self, weights: np.ndarray, rtol: float = EU_RESOLUTION) -> np.ndarray:
         """argmax_a w . Phi[a] per turn; ties go to no query, else to the first (``irl_policy.greedy_choice``)."""
         utilities = np.where(self.valid, self.phi @ np.asarray(weights, dtype=np.float64), -np.inf)
         best = utilities.max(axis=1, keepdims=True)

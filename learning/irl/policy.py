@@ -9,10 +9,11 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from learning.decision.resolution import EU_RESOLUTION
 from learning.irl.demonstrations import DecisionTurn, QuestioningEpisode
 
 
-def greedy_choice(turn: DecisionTurn, weights: np.ndarray, rtol: float = 1e-9) -> int:
+def greedy_choice(turn: DecisionTurn, weights: np.ndarray, rtol: float = EU_RESOLUTION) -> int:
     """The DT learner's action: argmax_a w . Phi[a]; a tie with no query goes to no query, else to the first."""
     utilities = turn.utilities(weights)
     best = float(utilities.max())

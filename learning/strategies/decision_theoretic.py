@@ -6,7 +6,9 @@ With weights w the expected utility is EU(a) = w . E[phi(s') | a]; every action,
 included, is scored at its own next state (eq. 7.1: the clock moves on, staying quiet learns
 nothing and lengthens the quiet run). The learner takes the best query a* only if it beats
 EU(no query), else it asks nothing this turn; ties between queries go to the first in
-candidate order (demos, labels, FSQ). Every explanation says what no query was scored at.
+candidate order (demos, labels, FSQ). Expected utilities closer than ``EU_RESOLUTION`` are
+equal (``learning.decision.resolution``), so that rounding decides neither a tie nor staying
+quiet. Every explanation says what no query was scored at.
 
 With embodied costs (thesis §8.2.2; the state's ``seconds_clock``) remaining time reads seconds at each
 candidate's own next state, (T_s - elapsed - E[seconds(a)]) / T_s (eq. 7.1), and of the queries that beat
@@ -28,12 +30,11 @@ from learning.actions import Action, Decision
 from learning.concepts import normalise_rows
 from learning.decision.candidates import CandidateFeatures
 from learning.decision.embodied import choose_per_second
+from learning.decision.resolution import EU_RESOLUTION, first_of_best
 from learning.decision.weights import resolve_weights, weighs_habits
 from learning.state import LearningState
 from learning.strategies.candidate_based import CandidateStrategy
 from learning.whatif import make_engine
-
-GAIN_TOLERANCE = 1e-12
 
 
 class DecisionTheoreticStrategy(CandidateStrategy):
@@ -56,7 +57,7 @@ class DecisionTheoreticStrategy(CandidateStrategy):
         best, stay = choose_index(utilities, candidates.seconds), candidates.no_query_index
         if best == stay:
             queries = utilities[:-1]
-            top = int(np.argmax(queries))
+            top = best_query(queries)
             return Decision(candidates.actions[stay], _quiet_reason(state, candidates.actions[top], queries[top],
                                                                       utilities[stay]))
         action = candidates.actions[best]
@@ -78,16 +79,21 @@ def quiet_basis(state: LearningState) -> str:
 def choose_index(utilities: np.ndarray, seconds: np.ndarray | None = None) -> int:
     """argmax over the candidates, no query (the last) unless a query beats it by more than rounding.
 
+    Queries within ``EU_RESOLUTION`` of the best are a tie, which goes to the first in candidate order.
     With embodied costs (``seconds``: E[seconds(a)] of every candidate), the query with the largest gain over
     no query per expected second among those that beat it (thesis §8.2.2 on eq. 7.1;
     :func:`learning.decision.embodied.choose_per_second`)."""
     if seconds is not None:
-        return choose_per_second(utilities, seconds, GAIN_TOLERANCE)
+        return choose_per_second(utilities, seconds, EU_RESOLUTION)
     queries, stay = utilities[:-1], utilities[-1]
-    if len(queries) == 0:
+    if len(queries) == 0 or queries.max() <= stay + EU_RESOLUTION * max(1.0, abs(stay)):
         return len(utilities) - 1
-    top = int(np.argmax(queries))  # ties: the first in candidate order
-    return top if queries[top] > stay + GAIN_TOLERANCE * max(1.0, abs(stay)) else len(utilities) - 1
+    return best_query(queries)
+
+
+def best_query(queries: np.ndarray) -> int:
+    """The first query whose expected utility is within ``EU_RESOLUTION`` of the best one's."""
+    return first_of_best(queries, EU_RESOLUTION * max(1.0, abs(float(queries.max()))))
 
 
 def _describe(state: LearningState, action: Action) -> str:

@@ -10,6 +10,7 @@ from hypothesis import strategies as st
 from learning.actions import DemoQuery, FeatureQuery, NoQuery
 from learning.decision.candidates import expected_decision_features
 from learning.decision.features import FEATURE_NAMES
+from learning.decision.resolution import EU_RESOLUTION
 from learning.decision.weights import PRESETS, load_weight_file, preset_weights, resolve_weights
 from learning.strategies import STRATEGY_NAMES, DecisionTheoreticStrategy, make_strategy
 from learning.strategies.decision_theoretic import choose_index
@@ -94,6 +95,17 @@ def test_dt_takes_the_argmax_and_breaks_ties_towards_no_query():
     assert choose_index(np.array([0.2, 0.5, 0.4, 0.3])) == 1
     assert choose_index(np.array([0.2, 0.5, 0.5])) == 2  # a query must beat U(s), not tie it
     assert choose_index(np.array([0.7])) == 0
+
+
+def test_dt_treats_expected_utilities_closer_than_its_resolution_as_equal():
+    """Rounding (e.g. a single- instead of a double-precision factor, ~1e-8) decides no tie: of two queries within
+    EU_RESOLUTION the first in candidate order is asked, and a query that beats no query only by rounding is not."""
+    below = 0.2 * EU_RESOLUTION
+    assert choose_index(np.array([0.213, 0.213 + below, 0.1])) == 0
+    assert choose_index(np.array([0.213, 0.213 + 5 * EU_RESOLUTION, 0.1])) == 1  # a real difference still counts
+    assert choose_index(np.array([0.3, 0.3 - below])) == 1  # no query, not a rounding-level gain
+    assert choose_index(np.array([0.3 + 5 * EU_RESOLUTION, 0.3])) == 0
+    assert choose_index(np.array([-40.0, -40.0 + 20 * below, -41.0])) == 0  # relative to |EU| when it exceeds 1
 
 
 def test_dt_chooses_what_its_expected_features_say():

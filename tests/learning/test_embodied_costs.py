@@ -49,6 +49,9 @@ def test_the_rule_takes_the_largest_gain_per_second_among_queries_that_beat_no_q
     assert choose_per_second(utilities, np.array([13.0, 11.0, 40.0, 2.0]), 1e-12) == 1  # 0.2/11 > 0.6/40
     assert choose_per_second(utilities, np.array([13.0, 11.0, 20.0, 2.0]), 1e-12) == 2  # 0.6/20 > 0.2/11
     assert choose_per_second(np.array([0.2, 0.1, 0.3]), np.array([5.0, 5.0, 2.0]), 1e-12) == 2  # none beats quiet
+    rounding = np.array([0.50, 0.50 + 1e-9, 0.30])  # equal gains up to rounding, equal seconds: the first
+    assert choose_per_second(rounding, np.array([10.0, 10.0, 2.0]), 1e-6) == 0
+    assert choose_per_second(rounding, np.array([10.0, 9.0, 2.0]), 1e-6) == 1  # a real rate difference counts
 
 
 def test_dt_prefers_the_near_object_when_gains_tie():
