@@ -8,9 +8,10 @@ engine's caches as the loop leaves them (a decision after a quiet turn reuses th
 version and scene; one after an answer is cold). Each decision is labelled with its training-set size,
 scene size and whether the feature query is still open.
 
-Every ``--reference-every``-th decision is also scored by the brute-force reference engine, outside the
-timed section (the reference caches nothing and draws no random number, so the episode is unchanged): the
-same action as the fast engine, the reference's regret of the fast choice, and the speedup of the median
+Every ``--reference-every``-th decision with a real choice (more than no query affordable) is also scored
+by the brute-force reference engine, outside the timed section (the reference caches nothing and draws no
+random number, so the episode is unchanged): the same action as the fast engine, the reference's regret of
+the fast choice, and the speedup of the median
 fast decision over the median reference one in this run.
 
     python scripts/bench_played.py --suite ch6-static --condition static --json   # last line: one JSON object
@@ -49,7 +50,7 @@ def _parse(argv):
     parser.add_argument("--budget", type=float, help="override every condition's question budget")
     parser.add_argument("--turns", type=int, help="override every condition's number of turns")
     parser.add_argument("--reference-every", type=int, default=10,
-                        help="score every Nth decision with the reference too (default 10; 0: never)")
+                        help="score every Nth decision with a choice by the reference too (default 10; 0: never)")
     parser.add_argument("--json", action="store_true", help="end with one JSON line")
     args = parser.parse_args(argv)
     if args.datasets < 1 or args.reference_every < 0 or (args.turns is not None and args.turns < 1) \
@@ -65,7 +66,7 @@ class DecisionLog:
         self.strategy, self.reference_every = strategy, reference_every
         self.rows: list[dict] = []
         self.checks: list[dict] = []
-        self._choose, self._last_version = strategy.choose, None
+        self._choose, self._last_version, self._choices = strategy.choose, None, 0
         strategy.choose = self.choose  # type: ignore[method-assign]
 
     def choose(self, state, rng):
@@ -78,8 +79,10 @@ class DecisionLog:
                           "fsq_open": not state.feature_query_asked, "cold": cold,
                           "candidates": 0 if self.strategy.last_candidates is None
                           else len(self.strategy.last_candidates.actions)})
-        if self.reference_every and len(self.rows) % self.reference_every == 0:
-            self.checks.append(self._check(state, cpu_ms))
+        if self.rows[-1]["candidates"] > 1:  # a real choice (no query is not the only candidate)
+            self._choices += 1
+            if self.reference_every and self._choices % self.reference_every == 0:
+                self.checks.append(self._check(state, cpu_ms))
         return decision
 
     def _check(self, state, fast_cpu_ms: float) -> dict:
