@@ -167,8 +167,9 @@ def main(args) -> int:
     with tempfile.TemporaryDirectory() as results:
         specs = episode_specs(suite, Path(results))
         warm_up = [row["cpu_ms"] for row in play(specs[0], args.strategy, 0)[0]]
-        print(f"warm-up (the first episode, played once untimed): its slowest decision {max(warm_up):.1f} ms, the "
-              "process's first uses (imports, per-process caches) included", flush=True)
+        print(f"warm-up (the first episode, played once untimed): its slowest decision {max(warm_up):.1f} ms, with "
+              "the process's one-time costs (e.g. Python's first full garbage collection after the data sets load)",
+              flush=True)
         for condition in conditions:
             rows, checks = [], []
             for spec in (s for s in specs if s.condition.name == condition.name):

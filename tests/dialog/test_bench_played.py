@@ -1,6 +1,5 @@
 """scripts/bench_played.py: DT's decisions timed as a suite's episodes play them, checked against the reference."""
 
-import importlib.util
 import json
 from dataclasses import replace
 from pathlib import Path
@@ -11,15 +10,11 @@ from dialog.experiments.episodes import run_episode
 from dialog.experiments.runner import episode_specs
 from dialog.experiments.suite import load_suite
 from learning.strategies import make_strategy
-
-SCRIPT = Path(__file__).resolve().parents[2] / "scripts" / "bench_played.py"
+from tests.scripts import load_script
 
 
 def _load():
-    spec = importlib.util.spec_from_file_location("bench_played", SCRIPT)
-    bench = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(bench)
-    return bench
+    return load_script("bench_played")
 
 
 def test_timing_and_reference_checks_leave_the_episode_unchanged(tmp_path):

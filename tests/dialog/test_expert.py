@@ -12,6 +12,7 @@ from learning.actions import DEFAULT_COSTS
 from learning.decision.candidates import expected_decision_features
 from learning.irl.demonstrations import load_episodes
 from tests.dialog.fakes import FakeEnvironment
+from tests.scripts import load_script
 
 TRAINING = dict(budget=15.0, turns=30, change_every=10)  # thesis §7.4.1
 
@@ -136,17 +137,12 @@ def test_the_scripted_expert_strategy_asks_what_expert_mode_asks(tmp_path):
 
 def test_shipped_demonstrations_are_the_suite_episodes_of_the_expert_strategy(tmp_path):
     """scripts/make_expert_demos.py plays the ch7-training condition on its data sets, as `regress` does."""
-    import importlib.util
     from dataclasses import replace
-    from pathlib import Path
 
     from dialog.experiments.episodes import run_episode
     from dialog.experiments.suite import load_suite
 
-    path = Path(__file__).resolve().parents[2] / "scripts" / "make_expert_demos.py"
-    spec_of = importlib.util.spec_from_file_location("make_expert_demos", path)
-    script = importlib.util.module_from_spec(spec_of)
-    spec_of.loader.exec_module(script)
+    script = load_script("make_expert_demos")
     suite = load_suite("ch7-training")
     spec = script.episode_spec(suite, 6, suite.data_seed)
     assert (spec.dataset, spec.episode_seed, spec.data_seed) == (6 % suite.datasets, 6000 + 6 % suite.datasets, 100)

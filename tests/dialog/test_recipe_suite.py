@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import csv
-import importlib.util
 import json
 from pathlib import Path
 
@@ -14,6 +13,7 @@ from dialog.cli import main
 from dialog.experiments import baseline
 from dialog.experiments.recipes.suite import evaluate_recipe_findings, load_study, summarise_study
 from dialog.experiments.suite import SuiteError, load_suite
+from tests.scripts import load_script
 
 TINY = """
 name = "tiny-recipes"
@@ -169,10 +169,7 @@ def test_findings_compare_across_checkpoints_and_a_margin_makes_a_non_inferiorit
 
 
 def test_the_experiment_script_still_runs_on_the_shared_implementation(tmp_path, capsys):
-    script = Path(__file__).resolve().parents[2] / "scripts" / "recipe_experiments.py"
-    spec = importlib.util.spec_from_file_location("recipe_experiments", script)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
+    module = load_script("recipe_experiments")
     assert module.main(["--kitchens", "kitchen-1", "kitchen-2", "--cv-demos", "3", "--cv-repeats", "1",
                         "--transfer-demos", "3", "--transfer-m", "1", "--transfer-repeats", "1",
                         "--out", str(tmp_path), "--json"]) == 0

@@ -1,18 +1,13 @@
 """scripts/bench_decision.py: the JSON row splits the fast decision's CPU time by whether the feature query is open,
 times ES alone on the open states and the time inside LAPACK (issue 28's floors)."""
 
-import importlib.util
 import json
-from pathlib import Path
 
-SCRIPT = Path(__file__).resolve().parents[2] / "scripts" / "bench_decision.py"
+from tests.scripts import load_script
 
 
 def _load():
-    spec = importlib.util.spec_from_file_location("bench_decision", SCRIPT)
-    bench = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(bench)
-    return bench
+    return load_script("bench_decision")
 
 
 def test_the_row_has_the_split_by_feature_query_and_es_alone(capsys):

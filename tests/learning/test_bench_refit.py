@@ -1,16 +1,12 @@
 """scripts/bench_refit.py: its last line has the shape issue 28 asks for, and the update equals the fresh fit."""
 
-import importlib.util
 import json
-from pathlib import Path
 
-SCRIPT = Path(__file__).resolve().parents[2] / "scripts" / "bench_refit.py"
+from tests.scripts import load_script
 
 
 def test_the_last_line_is_the_rows_and_the_two_growth_exponents(capsys):
-    spec = importlib.util.spec_from_file_location("bench_refit", SCRIPT)
-    bench = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(bench)
+    bench = load_script("bench_refit")
     assert bench.main(bench._parse(["--sizes", "30", "500", "600", "--repeats", "1", "--json"])) == 0
     lines = capsys.readouterr().out.strip().splitlines()
     result = json.loads(lines[-1])
