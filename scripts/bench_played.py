@@ -11,8 +11,7 @@ scene size and whether the feature query is still open.
 Every ``--reference-every``-th decision with a real choice (more than no query affordable) is also scored
 by the brute-force reference engine, outside the timed section (the reference caches nothing and draws no
 random number, so the episode is unchanged): the same action as the fast engine, the reference's regret of
-the fast choice, and the speedup of the median
-fast decision over the median reference one in this run.
+the fast choice, and the speedup of the median fast decision over the median reference one in this run.
 
     python scripts/bench_played.py --suite ch6-static --condition static --json   # last line: one JSON object
 """
@@ -87,13 +86,13 @@ class DecisionLog:
 
     def _check(self, state, fast_cpu_ms: float) -> dict:
         """The reference's choice on this state and its regret of the fast one (eq. 7.1), untimed by the episode."""
-        strategy, habits = self.strategy, weighs_habits(self.strategy.weights)
-        fast = expected_decision_features(state, "fast", strategy.window_factor, seconds=strategy.embodied,
-                                          habits=habits)
+        strategy, fast = self.strategy, self.strategy.last_candidates  # what the timed choice saw
+        habits = weighs_habits(strategy.weights)
         started = time.process_time()
         reference = expected_decision_features(state, "reference", strategy.window_factor,
                                                seconds=strategy.embodied, habits=habits)
         reference_cpu_ms = 1e3 * (time.process_time() - started)
+        assert reference.actions == fast.actions, "both engines score the same candidates"
         fast_eu, reference_eu = fast.utilities(strategy.weights), reference.utilities(strategy.weights)
         fast_choice = choose_index(fast_eu, fast.seconds)
         reference_choice = choose_index(reference_eu, reference.seconds)
