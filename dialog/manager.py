@@ -97,6 +97,7 @@ class DialogManager:
         self.replay_mismatches = 0
         self._epoch = -1
         self._test = None
+        self._test_accuracy: tuple[int, float] | None = None  # (model version, held-out accuracy)
         self._undo_stack: list[tuple] = []
         self.questioner = Questioner(environment, self.state, config.pictures)
         self.embodied = load_embodied_costs() if config.seconds is not None else None  # dialog/embodied.py
@@ -136,14 +137,13 @@ class DialogManager:
         return self.finish(time.perf_counter() - started)
 
     def finish(self, seconds: float = 0.0) -> EpisodeResult:
-        test_X, test_y = self._test
         kinds = Counter(self.state.history)
         return EpisodeResult(
             seed=self.config.seed, strategy=self.strategy.name, turns=self.config.turns,
             budget_spent=self.state.spent,
             queries={"label": kinds["label"], "demo": kinds["demo"], "feature": kinds["feature"],
                      "none": kinds["none"]},
-            accuracy=accuracy(self.state.predict(test_X), test_y), transcript=str(self.transcript.path),
+            accuracy=self.test_accuracy(), transcript=str(self.transcript.path),
             seconds=seconds, completed=self.turn, quit=self.quit,
         )
 
@@ -266,13 +266,12 @@ class DialogManager:
     def _close_turn(self, record: dict, action: Action, outcome: Outcome) -> dict:
         if self.state.turn == self.turn:  # nothing applied this turn (no question was asked): record it as such
             self.state.apply(action, None)
-        test_X, test_y = self._test
         record.update({
             "answer": answer_record(outcome, action, self.state.feature_names),
             "cost": self.state.cost(action), "budget_left": self.state.remaining_budget,
             "model": self.model_summary(),
             "ended": round(self.clock.now(), 3),
-            "accuracy": round(accuracy(self.state.predict(test_X), test_y), 6),
+            "accuracy": round(self.test_accuracy(), 6),
         })
         if self.embodied is not None:  # how long the turn took
             record["seconds"] = round(record["ended"] - record["time"], 3)
@@ -280,6 +279,15 @@ class DialogManager:
         self.turn += 1
         self._notify("on_turn", record, self.scene)
         return record
+
+    def test_accuracy(self) -> float:
+        """Accuracy on the held-out test set, computed once per model version: the models and the scaler change
+        only in a refit, which bumps the version, so a turn that taught nothing reuses the last value exactly."""
+        version = self.state.version
+        if self._test_accuracy is None or self._test_accuracy[0] != version:
+            test_X, test_y = self._test
+            self._test_accuracy = (version, accuracy(self.state.predict(test_X), test_y))
+        return self._test_accuracy[1]
 
     def _ask(self, prompt: Prompt) -> tuple[Outcome, list[int]]:
         """Converse until the question ends; "undo" takes back earlier answers (applied once it ends)."""
