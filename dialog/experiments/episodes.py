@@ -19,7 +19,7 @@ from dialog.experiments.suite import Condition
 from dialog.manager import episode_generators
 from dialog.settings import EpisodeSettings
 from dialog.threads import one_blas_thread
-from dialog.transcripts.jsonl import TranscriptWriter, read_transcript
+from dialog.transcripts.jsonl import TranscriptWriter
 from dialog.user_weights import UserWeights
 from learning.errors import SettingsError
 from learning.strategies import Strategy
@@ -100,12 +100,24 @@ def _run_episode(spec: EpisodeSpec, strategy: Strategy | None = None) -> dict:
     timing = embodied_timing(condition.seconds)
     teacher = suite_teacher(dict(spec.teacher), rngs["teacher"], timing.clock, timing.answer_delays)
     Path(spec.transcript).parent.mkdir(parents=True, exist_ok=True)
+    turns = TurnRecords()
     with TranscriptWriter(spec.transcript) as transcript:
         result = build_episode(settings, environment, teacher, transcript, strategy=strategy, rngs=rngs,
-                               say=lambda _: None, clock=timing.clock).run()
-    series = series_from_transcript(read_transcript(spec.transcript))
+                               say=lambda _: None, clock=timing.clock, observers=(turns,)).run()
+    series = series_from_transcript(turns.records)
     return {"spec": asdict(spec), "label": spec.label, "series": series, "accuracy": result.accuracy,
             "seconds": time.perf_counter() - started, "cpu_seconds": time.process_time() - started_cpu}
+
+
+class TurnRecords:
+    """An observer keeping every turn record as the manager wrote it to the transcript, so that the series are
+    built from the records in memory instead of reading the file back (JSON keeps every value exactly)."""
+
+    def __init__(self) -> None:
+        self.records: list[dict] = []
+
+    def on_turn(self, record: dict, scene) -> None:
+        self.records.append(record)
 
 
 def series_from_transcript(records: list[dict]) -> dict[str, list]:
