@@ -10,7 +10,7 @@ from numbers import Real
 
 import numpy as np
 
-from learning.gp import BinaryGPClassifier
+from learning.gp import BinaryGPClassifier, rbf_kernel
 
 # A feature whose observed spread is below this fraction of its magnitude (or of 1) has shown no
 # variation yet; it keeps unit scale instead of blowing small test differences up to huge z-scores.
@@ -129,11 +129,16 @@ class ConceptModels:
         fitted = getattr(self, "models_", {})  # an answer that only adds rows updates these (BinaryGPClassifier.fit)
         self.subsets_ = {c: subsets.get(c) for c in self.concepts}
         models = {}
+        kernels: dict[tuple, np.ndarray] = {}  # a fresh fit's kernel, shared by the concepts on the same columns
         try:
             for concept in self.concepts:
                 columns = self.columns(concept, X.shape[1])
-                models[concept] = BinaryGPClassifier(self.length_scale, self.variance).fit(
-                    X[:, columns], labels == concept, previous=fitted.get(concept))
+                key = tuple(columns.tolist())
+                model = BinaryGPClassifier(self.length_scale, self.variance).fit(
+                    X[:, columns], labels == concept, previous=fitted.get(concept), kernel=kernels.get(key))
+                if len(X) and not model.incremental_:
+                    kernels.setdefault(key, model.K_)
+                models[concept] = model
         except Exception:
             if previous is None:
                 del self.subsets_
@@ -149,10 +154,22 @@ class ConceptModels:
         return np.arange(n_features) if subset is None or len(subset) == 0 else np.asarray(subset)
 
     def predict(self, X: np.ndarray) -> np.ndarray:
-        """(n, |Y|) matrix of p(y | x) for standardised rows ``X``."""
-        return np.column_stack([
-            self.models_[c].predict_proba(X[:, self.columns(c, X.shape[1])]) for c in self.concepts
-        ])
+        """(n, |Y|) matrix of p(y | x) for standardised rows ``X``.
+
+        The concepts on the same columns share their training rows, so the kernel between those rows and ``X``
+        is computed once for all of them (the same bits each would compute)."""
+        shared: dict[tuple, tuple[np.ndarray, np.ndarray | None]] = {}
+        columns_of_X = []
+        for concept in self.concepts:
+            model, columns = self.models_[concept], self.columns(concept, X.shape[1])
+            key = tuple(columns.tolist())
+            if key not in shared:
+                rows = X[:, columns]
+                fitted = len(model.targets_) > 0
+                shared[key] = (rows, rbf_kernel(model.X_train_, rows, model.length_scale_, model.variance)
+                               if fitted else None)
+            columns_of_X.append(model.predict_proba(*shared[key]))
+        return np.column_stack(columns_of_X)
 
 
 def checked_subset(indices, n_features: int, what: str = "feature indices") -> np.ndarray:

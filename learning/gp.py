@@ -46,12 +46,15 @@ class BinaryGPClassifier:
         self.tolerance = tolerance
         self.incremental_from = incremental_from
 
-    def fit(self, X: np.ndarray, y: np.ndarray, previous: BinaryGPClassifier | None = None) -> BinaryGPClassifier:
+    def fit(self, X: np.ndarray, y: np.ndarray, previous: BinaryGPClassifier | None = None,
+            kernel: np.ndarray | None = None) -> BinaryGPClassifier:
         """Fit on rows ``X`` with labels ``y`` in {0, 1} (or booleans).
 
         ``previous``: an earlier fit of this kind. When ``X`` and ``y`` only append rows to its training set
         (same kernel, same rows before them), the fit is updated instead of redone (``_extend``): its kernel
         is reused and Newton starts at its mode. The result equals a fresh fit within the Newton tolerance.
+        ``kernel``: ``rbf_kernel(X, X)`` as another classifier on the same rows and kernel already computed it
+        (the same bits); a fresh fit uses it instead of computing it again, is never written to it.
         """
         X = np.asarray(X, dtype=float)
         y = np.asarray(y).astype(float).ravel()
@@ -70,7 +73,9 @@ class BinaryGPClassifier:
             self.f_hat_, self.W_sqrt_, self.L_ = self._extend(previous, self.K_, self.targets_)
             self.incremental_ = True
         else:
-            self.K_ = rbf_kernel(X, X, self.length_scale_, self.variance)
+            if kernel is not None and kernel.shape != (len(X), len(X)):
+                raise ValueError(f"kernel must be ({len(X)}, {len(X)}) for {len(X)} rows, got {kernel.shape}")
+            self.K_ = rbf_kernel(X, X, self.length_scale_, self.variance) if kernel is None else kernel
             self.f_hat_, self.W_sqrt_, self.L_ = self._newton(self.K_, self.targets_)
         self.grad_ = (self.targets_ + 1) / 2 - sigmoid(self.f_hat_)  # d log p(y|f) / df at the mode
         return self
@@ -143,21 +148,22 @@ class BinaryGPClassifier:
         sw = np.sqrt(pi * (1 - pi))
         return f, sw, mode_factor(K, sw)
 
-    def latent(self, X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Predictive mean and variance of the latent function (R&W algorithm 3.2)."""
+    def latent(self, X: np.ndarray, cross: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """Predictive mean and variance of the latent function (R&W algorithm 3.2); ``cross`` is
+        ``rbf_kernel(X_train_, X)`` when a classifier on the same training rows already computed it."""
         X = np.asarray(X, dtype=float)
         if len(self.targets_) == 0:
             return np.zeros(len(X)), np.full(len(X), self.variance)
-        Ks = rbf_kernel(self.X_train_, X, self.length_scale_, self.variance)
+        Ks = rbf_kernel(self.X_train_, X, self.length_scale_, self.variance) if cross is None else cross
         mean = Ks.T @ self.grad_
         right = self.W_sqrt_[:, None] * Ks
         v = factor_solve(self.L_[0], right.astype(np.float32))  # B^-1 S K_ns (float32: see mode_factor)
         var = self.variance - np.sum(right * v, axis=0)
         return mean, np.maximum(var, 1e-12)
 
-    def predict_proba(self, X: np.ndarray) -> np.ndarray:
-        """p(y = 1 | x) by the probit approximation sigma(mu / sqrt(1 + pi var / 8))."""
-        mean, var = self.latent(X)
+    def predict_proba(self, X: np.ndarray, cross: np.ndarray | None = None) -> np.ndarray:
+        """p(y = 1 | x) by the probit approximation sigma(mu / sqrt(1 + pi var / 8)) (``cross``: see ``latent``)."""
+        mean, var = self.latent(X, cross)
         return sigmoid(mean / np.sqrt(1.0 + np.pi * var / 8.0))
 
 
