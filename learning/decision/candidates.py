@@ -40,6 +40,7 @@ from learning.decision.features import (
 )
 from learning.decision.habits import EXTENDED_FEATURE_NAMES, expected_habits
 from learning.whatif import WhatIfEngine, make_engine
+from learning.whatif.base import cached
 
 
 @dataclass(frozen=True)
@@ -130,12 +131,16 @@ def _expected_seven(state, engine, window_factor, actions, seconds) -> _SevenFea
     n_concepts = len(state.concepts)
     with_one_more = counts + np.eye(n_concepts)  # row y: the counts after one more example of concept y
     # Learning features of every simulated next state, all at once: (|Y|, |X|, 4), (k, |Y|, 4), (|Y|, 4).
-    demo_phi = learning_features(outcomes.demo, with_one_more[:, None, :])
+    # Shared outcomes (the fast engine's) are a function of the model version and the scene, and so are the
+    # counts: a turn with neither changed (a quiet one) reuses the features scored last turn, the same bits.
+    reuse = (state.version, state.scene_id) if outcomes.shared else None
+    demo_phi = _scored(state, "demo", reuse, lambda: learning_features(outcomes.demo, with_one_more[:, None, :]))
     if outcomes.shared:  # the same <x, y> states: score them once
         label_phi = demo_phi[:, list(outcomes.label_objects)].transpose(1, 0, 2)
     else:
         label_phi = learning_features(outcomes.label, with_one_more[None, :, :])
-    feature_phi = None if outcomes.feature is None else learning_features(outcomes.feature, counts)
+    feature_phi = None if outcomes.feature is None else _scored(
+        state, "feature", reuse, lambda: learning_features(outcomes.feature, counts))
     label_rows = {index: k for k, index in enumerate(outcomes.label_objects)}
     concept_index = {c: k for k, c in enumerate(state.concepts)}
     expected = np.empty((len(actions), len(current)))
@@ -162,6 +167,19 @@ def _expected_seven(state, engine, window_factor, actions, seconds) -> _SevenFea
             after[key] = clock.after(key[0], asked=True, seconds=key[1]).features()
         expected[i, learned.shape[1] :] = after[key]
     return _SevenFeatureTable(CandidateFeatures(actions, expected, current, seconds=durations), P, counts, outcomes)
+
+
+def _scored(state, part: str, version, compute):
+    """``compute()``, kept in the state's cache for ``version`` (None: computed every time, nothing kept)."""
+    if version is None:
+        return compute()
+
+    def kept():
+        value = compute()
+        value.setflags(write=False)
+        return value
+
+    return cached(state, f"candidates.{part}_phi", version, kept)
 
 
 def _expected_seconds(clock, actions, P: np.ndarray, concepts) -> np.ndarray | None:

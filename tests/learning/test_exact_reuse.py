@@ -1,0 +1,54 @@
+"""Work shared or reused for speed (issue 43) gives exactly the bits the recomputation would."""
+
+import numpy as np
+import pytest
+
+from learning.actions import FeatureQuery, LabelQuery, NoQuery
+from learning.concepts import ConceptModels
+from learning.decision.candidates import expected_decision_features
+from learning.gp import BinaryGPClassifier, rbf_kernel
+from learning.state import LearningState
+
+CONCEPTS = ("a", "b", "c")
+
+
+def _rows(rng, n=30, features=5):
+    return rng.normal(size=(n, features)), rng.choice(CONCEPTS, size=n).astype(object)
+
+
+@pytest.mark.parametrize("subsets", [{}, {"b": np.array([0, 2])}])
+def test_models_on_the_same_columns_share_kernels_and_give_each_models_own_bits(rng, subsets):
+    X, labels = _rows(rng)
+    models = ConceptModels(CONCEPTS).fit(X, labels, subsets)
+    test = rng.normal(size=(40, X.shape[1]))
+    alone = np.column_stack([models.models_[c].predict_proba(test[:, models.columns(c, X.shape[1])])
+                             for c in CONCEPTS])
+    assert np.array_equal(models.predict(test), alone)
+    for c in CONCEPTS:  # each fit equals a fit of its own, which computes its kernel itself
+        columns = models.columns(c, X.shape[1])
+        own = BinaryGPClassifier().fit(X[:, columns], labels == c)
+        assert np.array_equal(models.models_[c].K_, own.K_)
+        assert np.array_equal(models.models_[c].f_hat_, own.f_hat_)
+        assert np.array_equal(models.models_[c].predict_proba(test[:, columns]), own.predict_proba(test[:, columns]))
+
+
+def test_a_kernel_of_the_wrong_size_is_refused(rng):
+    X, labels = _rows(rng, 6)
+    with pytest.raises(ValueError, match=r"kernel must be \(6, 6\)"):
+        BinaryGPClassifier().fit(X, labels == "a", kernel=rbf_kernel(X[:4], X[:4], 1.0, 4.0))
+
+
+def test_a_quiet_turn_reuses_the_scored_what_ifs_and_gets_the_same_bits(rng):
+    state = LearningState(CONCEPTS, [f"f{i}" for i in range(5)], budget=20, turns=20)
+    scene, labels = _rows(rng, 12)
+    state.observe_scene(0, scene)
+    state.apply(LabelQuery(0), labels[0])
+    state.apply(LabelQuery(1), labels[1])
+    first = expected_decision_features(state, "fast", habits=True)
+    state.apply(NoQuery())  # nothing learned, the same scene: the cached scoring is used
+    reused = expected_decision_features(state, "fast", habits=True)
+    state.cache.clear()
+    fresh = expected_decision_features(state, "fast", habits=True)
+    assert np.array_equal(reused.expected, fresh.expected)
+    assert any(a == FeatureQuery() for a in fresh.actions)
+    assert not np.array_equal(first.expected[-1], reused.expected[-1])  # the clock moved: not a stale table
