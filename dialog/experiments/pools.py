@@ -41,7 +41,8 @@ class PoolSet:
 # progress(done, total, message): called after each pool is rendered (never when the pools come from the cache)
 RenderProgress = Callable[[int, int, str], None]
 KEPT_POOL_SETS = 4  # pool sets kept in memory per process
-_loaded: dict[tuple, PoolSet] = {}
+_loaded: dict[tuple, PoolSet] = {}  # by (task, kitchen, pools in the data set file, plan options, data seed)
+_pools_in_plan: dict[str, int] = {}  # each task's own number of training pools (its [datasets] plan)
 
 
 def load_pools(task: str, kitchen: str, datasets: int, plan_options: tuple = (),
@@ -58,12 +59,18 @@ def load_pools(task: str, kitchen: str, datasets: int, plan_options: tuple = (),
     if isinstance(datasets, bool) or not isinstance(datasets, int | np.integer) or datasets < 1:
         raise SettingsError(f"datasets must be a whole number of at least 1 (training data sets), got {datasets!r}")
     check_limit("datasets", datasets)
-    key = (task, kitchen, int(datasets), tuple(plan_options), int(data_seed))
+    if task not in _pools_in_plan:
+        _pools_in_plan[task] = load_task(task).datasets.pools
+    # Fewer pools than the plan's come from the plan's one file: one entry serves every count up to it, so a
+    # sweep over data sets 0..4 loads the file once, not once per data set.
+    in_file = max(int(datasets), _pools_in_plan[task])
+    key = (task, kitchen, in_file, tuple(plan_options), int(data_seed))
     if key not in _loaded:
         while len(_loaded) >= KEPT_POOL_SETS:
             _loaded.pop(next(iter(_loaded)))
         _loaded[key] = _load_pools(*key, progress)
-    return _loaded[key]
+    pools = _loaded[key]
+    return pools if len(pools.train) == datasets else replace(pools, train=pools.train[:datasets])
 
 
 def _load_pools(task: str, kitchen: str, datasets: int, plan_options: tuple, data_seed: int, progress) -> PoolSet:
