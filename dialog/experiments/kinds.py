@@ -103,7 +103,11 @@ def get_kind(name: str) -> SuiteKind:
     kinds = registered()
     if name not in kinds:
         raise SuiteError(f"unknown suite kind '{name}'; registered kinds: {', '.join(names)}")
-    return kinds[name]
+    kind = kinds[name]
+    if not isinstance(kind, SuiteKind):
+        raise TypeError(f"the suite kind registered as '{name}' ({type(kind).__name__}) is not a SuiteKind "
+                        "subclass (dialog.experiments.kinds.SuiteKind)")
+    return kind
 
 
 def run_suite(kind: SuiteKind, suite: Suite, options: RunOptions, original: Suite | None = None) -> SuiteRun:
