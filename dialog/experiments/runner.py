@@ -5,10 +5,12 @@ from __future__ import annotations
 import os
 import signal
 import sys
+import tempfile
 import threading
 import time
 from collections.abc import Callable
 from concurrent.futures import ProcessPoolExecutor, as_completed
+from dataclasses import replace
 from pathlib import Path
 
 from dialog.experiments.episodes import EpisodeSpec, run_episode
@@ -62,18 +64,33 @@ def run_locally(specs: list[EpisodeSpec], workers: int | None = None,
 
 
 def run_on_ray(specs: list[EpisodeSpec], address: str, progress: ProgressOption = True) -> list[dict]:
-    """Run the same episodes as Ray tasks on the cluster at ``address`` ("local" starts one here)."""
+    """Run the same episodes as Ray tasks on the cluster at ``address`` ("local" starts one here); each
+    transcript comes back with its result and is written here, wherever the episode ran."""
     ray = connect_ray(address)
-    remote_episode = ray.remote(run_episode)
+    remote_episode = ray.remote(episode_on_node)
     pending = {remote_episode.remote(spec): i for i, spec in enumerate(specs)}
     results: list[dict | None] = [None] * len(specs)
     with _progress(len(specs), progress) as advance:
         while pending:
             done, _ = ray.wait(list(pending), num_returns=1)
             index = pending.pop(done[0])
-            results[index] = ray.get(done[0])
+            results[index], transcript = ray.get(done[0])
+            path = Path(specs[index].transcript)
+            path.parent.mkdir(parents=True, exist_ok=True)
+            path.write_bytes(transcript)
             advance(specs[index].label)
     return results
+
+
+def episode_on_node(spec: EpisodeSpec) -> tuple[dict, bytes]:
+    """One episode on a cluster node: its transcript is written in the node's temporary folder (the driver's
+    results folder may not exist there) and sent back as bytes with the result."""
+    with tempfile.TemporaryDirectory(prefix="teachbot-episode-") as folder:
+        here = replace(spec, transcript=str(Path(folder) / Path(spec.transcript).name))
+        result = run_episode(here)
+        transcript = Path(here.transcript).read_bytes()
+    result["spec"]["transcript"] = spec.transcript
+    return result, transcript
 
 
 def connect_ray(address: str, command: str = "regress"):
