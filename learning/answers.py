@@ -9,16 +9,14 @@ takes back. ``apply_answer(state, action, answer)`` is the same call as a functi
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
+from typing import Protocol
 
 import numpy as np
 
 from learning.actions import Action
 from learning.concepts import checked_row, checked_subset
 from learning.errors import TeachbotError
-
-if TYPE_CHECKING:
-    from learning.state import Example, LearningState
+from learning.examples import Example
 
 
 class AnswerError(TeachbotError):
@@ -48,7 +46,27 @@ class DemoRow:
     x: object
 
 
-def check_answer(state: LearningState, action: Action, answer):
+class QuestionContext(Protocol):
+    """What checking an answer reads of the learner (``LearningState`` is one): the concepts, the feature
+    names and the current scene's rows."""
+
+    @property
+    def concepts(self) -> tuple[str, ...]: ...
+
+    @property
+    def feature_names(self) -> tuple[str, ...]: ...
+
+    @property
+    def scene_X(self) -> np.ndarray: ...
+
+
+class Learner(Protocol):
+    """A learner an answer can be applied to (``LearningState`` is one)."""
+
+    def apply(self, action: Action, answer) -> Change: ...
+
+
+def check_answer(state: QuestionContext, action: Action, answer):
     """The answer in canonical form (a concept name, an object index, a sorted index array or None); an
     AnswerError naming what is accepted otherwise. Changes nothing."""
     kind = action.kind
@@ -99,6 +117,6 @@ def feature_indices(feature_names, answer) -> np.ndarray:
         raise AnswerError(f"{error} (or feature names, or None to skip)") from None
 
 
-def apply_answer(state: LearningState, action: Action, answer) -> Change:
+def apply_answer(state: Learner, action: Action, answer) -> Change:
     """``state.apply(action, answer)``: learn from the answer and record the turn (see LearningState.apply)."""
     return state.apply(action, answer)

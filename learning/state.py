@@ -10,7 +10,7 @@ a bad call raises a ValueError naming what was wrong and leaves the state as it 
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from types import MappingProxyType
 
 import numpy as np
@@ -18,21 +18,10 @@ import numpy as np
 from learning.actions import DEFAULT_COSTS, Action, validate_costs
 from learning.answers import AnswerError, Change, DemoRow, check_answer, feature_indices
 from learning.concepts import ConceptModels, FeatureScaler, checked_rows
+from learning.examples import Example
 from learning.features.selection import SELECTION_METHODS, computational_subsets
 from learning.limits import check_limit
 from learning.progress import Progress, SceneView, read_only
-
-SOURCES = ("label", "demo")  # how a training example may have been obtained
-
-
-@dataclass(frozen=True)
-class Example:
-    """One labelled instance (a read-only row) and how it was obtained ("demo" or "label")."""
-
-    x: np.ndarray
-    concept: str
-    source: str
-    scene_id: int
 
 
 class LearningState:

@@ -22,6 +22,7 @@ import shlex
 import shutil
 import subprocess
 import sys
+import threading
 import time
 from pathlib import Path
 
@@ -41,6 +42,8 @@ from dialog.experiments.doc_tables import (  # noqa: E402
     stamp,
     verdict_words,
 )
+from dialog.experiments.progress import SweepProgress, relay  # noqa: E402
+from dialog.experiments.runner import episode_specs  # noqa: E402
 from dialog.experiments.suite import load_suite  # noqa: E402
 from learning.errors import SettingsError  # noqa: E402
 
@@ -51,9 +54,10 @@ def git(*words: str) -> str:
     return subprocess.run(["git", *words], cwd=ROOT, capture_output=True, text=True, check=True).stdout.strip()
 
 
-def command_for(run, plan: Plan, results: Path) -> list[str]:
+def command_for(run, plan: Plan, results: Path, progress: bool = True) -> list[str]:
     shown = os.path.relpath(results, ROOT) if results.resolve().is_relative_to(ROOT) else str(results)
-    words = ["teachbot", "regress", "--suite", run.suite, "--results", shown, "--no-progress", "--json"]
+    words = ["teachbot", "regress", "--suite", run.suite, "--results", shown,
+             "--progress-events" if progress else "--no-progress", "--json"]
     if load_suite(run.suite).kind == "episodes":  # other kinds (ch5, recipes): one run on their own data
         words += ["--data-seeds", *map(str, plan.data_seeds), "--seeds", *map(str, plan.seeds)]
     if run.strategies:
@@ -61,7 +65,31 @@ def command_for(run, plan: Plan, results: Path) -> list[str]:
     return words
 
 
-def run_all(plan: Plan, only: list[str] | None, out: Path, allow_dirty: bool) -> dict:
+def planned_episodes(run, plan: Plan) -> int:
+    """The episodes of one run of the plan (0 for a suite that is not an episodes suite: ch5, recipes)."""
+    suite = load_suite(run.suite)
+    if suite.kind != "episodes":
+        return 0
+    suite = suite.with_overrides(strategies=run.strategies or None, seeds=plan.seeds)
+    return len(episode_specs(suite, Path("results"))) * len(plan.data_seeds)
+
+
+def run_one(words: list[str], line: SweepProgress | None) -> subprocess.CompletedProcess:
+    """Run one ``teachbot regress``; its episode events advance ``line``, its other messages are shown."""
+    child = subprocess.Popen([sys.executable, "-m", "dialog.cli", *words[1:]], cwd=ROOT, text=True,
+                             stdout=subprocess.PIPE, stderr=None if line is None else subprocess.PIPE)
+    reader = None
+    if line is not None:
+        reader = threading.Thread(target=relay, args=(child.stderr, line, sys.stderr), daemon=True)
+        reader.start()
+    stdout = child.stdout.read() if child.stdout is not None else ""
+    child.wait()
+    if reader is not None:
+        reader.join()
+    return subprocess.CompletedProcess(child.args, child.returncode, stdout)
+
+
+def run_all(plan: Plan, only: list[str] | None, out: Path, allow_dirty: bool, progress: bool = True) -> dict:
     dirty = bool(git("status", "--porcelain", "--", *CODE))
     if dirty and not allow_dirty:
         raise SettingsError("the code has uncommitted changes (git status -- " + " ".join(CODE) + "): commit "
@@ -70,33 +98,43 @@ def run_all(plan: Plan, only: list[str] | None, out: Path, allow_dirty: bool) ->
     manifest = json.loads(manifest_path.read_text()) if manifest_path.exists() and only else {"runs": {}}
     manifest.update({"commit": git("rev-parse", "HEAD"), "dirty": dirty, "cores": os.cpu_count(),
                      "date": datetime.date.today().isoformat()})
-    for run in plan.runs:
-        if only and run.suite not in only:
-            continue
-        results = out / run.suite
-        if results.exists():
-            shutil.rmtree(results)
-        words = command_for(run, plan, results)  # as the stamps show it (the results folder relative to ROOT)
-        argv = words[1:]
-        argv[argv.index("--results") + 1] = str(results)  # run with the full path
-        print(f"$ {shlex.join(words)}", flush=True)
-        began = time.perf_counter()
-        done = subprocess.run([sys.executable, "-m", "dialog.cli", *argv], cwd=ROOT, text=True,
-                              stdout=subprocess.PIPE)
-        seconds = time.perf_counter() - began
-        print(done.stdout[-2000:], flush=True)
-        if done.returncode != 0:
-            raise SystemExit(f"experiments: '{shlex.join(words)}' failed with exit code {done.returncode}")
-        summary = json.loads(done.stdout.strip().splitlines()[-1])
-        manifest["runs"][run.suite] = {"command": shlex.join(words),
-                                       "wall_seconds": round(seconds, 1),
-                                       "episodes": summary.get("episodes"), "commit": manifest["commit"],
-                                       "dirty": dirty}
-        print(f"  {run.suite}: {seconds:.0f} s", flush=True)
+    runs = [run for run in plan.runs if not only or run.suite in only]
+    line = SweepProgress(sum(planned_episodes(run, plan) for run in runs)) if progress else None
+    try:
+        for run in runs:
+            _run_and_record(run, plan, out, manifest, dirty, line)
+    finally:
+        if line is not None:
+            line.close()
     manifest["wall_seconds"] = round(sum(r["wall_seconds"] for r in manifest["runs"].values()), 1)
     out.mkdir(parents=True, exist_ok=True)
     manifest_path.write_text(json.dumps(manifest, indent=1) + "\n")
     return manifest
+
+
+def _run_and_record(run, plan: Plan, out: Path, manifest: dict, dirty: bool, line: SweepProgress | None) -> None:
+    """One run of the plan (its results folder emptied first), its wall time and episodes into ``manifest``."""
+    say = print if line is None else line.note
+    results = out / run.suite
+    if results.exists():
+        shutil.rmtree(results)
+    words = command_for(run, plan, results, line is not None)  # as the stamps show it (results relative to ROOT)
+    words_run = list(words)
+    words_run[words_run.index("--results") + 1] = str(results)  # run with the full path
+    say(f"$ {shlex.join(words)}")
+    if line is not None:
+        line.describe(run.suite if planned_episodes(run, plan) else f"{run.suite} (not episodes: not counted)")
+    began = time.perf_counter()
+    done = run_one(words_run, line)
+    seconds = time.perf_counter() - began
+    say(done.stdout[-2000:])
+    if done.returncode != 0:
+        raise SystemExit(f"experiments: '{shlex.join(words)}' failed with exit code {done.returncode}")
+    summary = json.loads(done.stdout.strip().splitlines()[-1])
+    manifest["runs"][run.suite] = {"command": shlex.join(words), "wall_seconds": round(seconds, 1),
+                                   "episodes": summary.get("episodes"), "commit": manifest["commit"],
+                                   "dirty": dirty}
+    say(f"  {run.suite}: {seconds:.0f} s")
 
 
 def tables_from(plan: Plan, manifest: dict, out: Path) -> dict[str, str]:
@@ -218,6 +256,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--suites", nargs="+", default=None, help="only these runs of the plan")
     parser.add_argument("--allow-dirty", action="store_true", help="run with uncommitted code changes")
     parser.add_argument("--json", action="store_true", help="end with one JSON line: the manifest")
+    parser.add_argument("--no-progress", action="store_true",
+                        help="no progress line (default: one line for the whole run on standard error)")
     args = parser.parse_args(argv)
     try:
         plan = load_plan(args.plan)
@@ -231,7 +271,7 @@ def main(argv: list[str] | None = None) -> int:
                 raise SettingsError(f"{manifest_path}: no run to render from (run without --render first)")
             manifest = json.loads(manifest_path.read_text())
         else:
-            manifest = run_all(plan, args.suites, args.results, args.allow_dirty)
+            manifest = run_all(plan, args.suites, args.results, args.allow_dirty, not args.no_progress)
         for line in render(plan, manifest, args.results):
             print(f"wrote {line}")
     except SettingsError as error:

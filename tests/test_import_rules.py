@@ -1,5 +1,6 @@
 """docs/architecture.md's import rules: learning stays pure; bullet_world never imports robot or dialog; robot never
-dialog; the house has no import circle; inside dialog/ imports run down the layers."""
+dialog; the project (its four packages and scripts/) has no import circle, counting the imports made only for type
+checkers; inside dialog/ imports run down the layers."""
 
 import ast
 from graphlib import CycleError, TopologicalSorter
@@ -43,6 +44,7 @@ def test_the_checker_catches_a_forbidden_import(tmp_path):
 
 
 HOUSE = ("bullet_world", "robot", "learning", "dialog")
+SCRIPTS = "scripts"  # not a package: a script imports its siblings by their bare names (scripts/ is on sys.path)
 # dialog/'s layers, lowest first: a module imports only modules of its own layer or of a lower one
 DIALOG_LAYERS = (
     ("dialog.clock", "dialog.threads", "dialog.interrupts", "dialog.output_paths"),
@@ -67,24 +69,26 @@ def house_modules() -> dict[str, Path]:
     return modules
 
 
-def _runs_only_for_type_checkers(node: ast.AST) -> bool:
-    return isinstance(node, ast.If) and isinstance(node.test, ast.Name) and node.test.id == "TYPE_CHECKING"
+def project_modules() -> dict[str, Path]:
+    """The house's modules and the scripts (as ``scripts.NAME``)."""
+    return house_modules() | {f"{SCRIPTS}.{path.stem}": path for path in sorted((ROOT / SCRIPTS).glob("*.py"))}
 
 
 def imported_modules(name: str, path: Path, modules) -> set[str]:
-    """The house modules ``name`` imports anywhere (functions too), but not under ``if TYPE_CHECKING``."""
+    """The project modules ``name`` imports anywhere: in functions and under ``if TYPE_CHECKING`` too (a type
+    named across modules ties them as much as a call does)."""
     package = name if path.name == "__init__.py" else name.rpartition(".")[0]
     found: set[str] = set()
 
     def resolve(target: str) -> None:
+        if name.startswith(f"{SCRIPTS}.") and f"{SCRIPTS}.{target}" in modules:
+            target = f"{SCRIPTS}.{target}"  # a script's sibling, imported by its bare name
         while target and target not in modules:
             target = target.rpartition(".")[0]
         if target and target != name:
             found.add(target)
 
     def visit(node: ast.AST) -> None:
-        if _runs_only_for_type_checkers(node):
-            return
         if isinstance(node, ast.Import):
             for alias in node.names:
                 resolve(alias.name)
@@ -103,15 +107,37 @@ def imported_modules(name: str, path: Path, modules) -> set[str]:
 
 
 def import_graph() -> dict[str, set[str]]:
-    modules = house_modules()
+    modules = project_modules()
     return {name: imported_modules(name, path, modules) for name, path in modules.items()}
 
 
-def test_the_house_has_no_import_circle():
+def import_circle(graph: dict[str, set[str]]) -> list[str]:
+    """One import circle of ``graph`` (its modules in import order, the first repeated at the end); [] if none."""
     try:
-        tuple(TopologicalSorter(import_graph()).static_order())
+        tuple(TopologicalSorter(graph).static_order())
     except CycleError as error:
-        pytest.fail(f"import circle: {' -> '.join(error.args[1])}")
+        return list(reversed(error.args[1]))  # graphlib lists a circle against the direction of the imports
+    return []
+
+
+def test_the_project_has_no_import_circle():
+    circle = import_circle(import_graph())
+    assert not circle, f"import circle: {' -> '.join(circle)}"
+
+
+def test_a_circle_closed_only_for_type_checkers_counts(tmp_path):
+    (tmp_path / "a.py").write_text("from typing import TYPE_CHECKING\nif TYPE_CHECKING:\n    from dialog.b import B\n")
+    (tmp_path / "b.py").write_text("from dialog.a import A\n")
+    modules = {"dialog": tmp_path / "a.py", "dialog.a": tmp_path / "a.py", "dialog.b": tmp_path / "b.py"}
+    graph = {name: imported_modules(name, path, modules) for name, path in modules.items() if name != "dialog"}
+    assert graph == {"dialog.a": {"dialog.b"}, "dialog.b": {"dialog.a"}}
+    assert import_circle(graph) in (["dialog.a", "dialog.b", "dialog.a"], ["dialog.b", "dialog.a", "dialog.b"])
+
+
+def test_scripts_importing_each_other_are_in_the_graph():
+    graph = import_graph()
+    assert "scripts._fuzz_corpus" in graph["scripts.fuzz_teach"]
+    assert "dialog.experiments.suite" in graph["scripts.experiments"]
 
 
 def dialog_layer(module: str) -> int | None:

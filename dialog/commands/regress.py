@@ -9,6 +9,8 @@ from __future__ import annotations
 import argparse
 import json
 import shlex
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 from dialog.commands._arguments import budget, data_seed, positive_int, seeds
@@ -19,6 +21,8 @@ from dialog.experiments.baseline import (
     write_baseline,
 )
 from dialog.experiments.kinds import RunOptions, get_kind, run_suite
+from dialog.experiments.progress import EventProgress, Progress, SweepProgress
+from dialog.experiments.runner import episode_specs
 from dialog.experiments.suite import load_suite, suite_names
 from dialog.output_paths import check_writable, writing
 from dialog.user_weights import named_weights, read_named_weights
@@ -62,7 +66,10 @@ def register(commands) -> None:
                         help="run the episodes on the Ray cluster at ADDRESS ('local' starts one here)")
     parser.add_argument("--check", action="store_true", help="exit 1 when a strategy leaves its baseline band")
     parser.add_argument("--update-baseline", action="store_true", help="store this run as the suite's baseline")
-    parser.add_argument("--no-progress", action="store_true", help="no progress bar")
+    parser.add_argument("--no-progress", action="store_true", help="no progress line")
+    parser.add_argument("--progress-events", action="store_true",
+                        help="instead of the progress line, one line per finished episode on standard error, "
+                             "for a parent process that shows the progress of a longer run (make experiments)")
     parser.add_argument("--json", action="store_true", help="end with one JSON line summarising the run")
     parser.set_defaults(handler=run)
 
@@ -73,6 +80,28 @@ def _embodied_seconds(args: argparse.Namespace) -> float | None:
     from dialog.embodied import default_allocation
 
     return default_allocation()
+
+
+def shows_bars(args: argparse.Namespace) -> bool:
+    """Bars and lines of the run's own (not with --no-progress, nor for a parent process reading events)."""
+    return not (args.no_progress or args.progress_events)
+
+
+@contextmanager
+def sweep_progress(args: argparse.Namespace, kind, suite, out: Path, data_seeds: int) -> Iterator[Progress | None]:
+    """The one progress line of the whole run (every episode of every data seed), or the events a parent reads;
+    None where the kind shows its own (not an episodes suite) or nothing is shown (--no-progress)."""
+    if args.progress_events:
+        yield EventProgress()
+        return
+    if args.no_progress or kind.name != "episodes":
+        yield None
+        return
+    line = SweepProgress(len(episode_specs(suite, out)) * data_seeds)
+    try:
+        yield line
+    finally:
+        line.close()
 
 
 def run(args: argparse.Namespace) -> int:
@@ -94,9 +123,9 @@ def run(args: argparse.Namespace) -> int:
     check_writable(out, "results", folder=True)
     if args.data_seeds is not None:
         return run_on_data_seeds(args, kind, suite, original, out)
-    with writing(out, "results", inside=True):
+    with writing(out, "results", inside=True), sweep_progress(args, kind, suite, out, 1) as sweep:
         out.mkdir(parents=True, exist_ok=True)
-        options = RunOptions(results=out, workers=args.workers, ray=args.ray, progress=not args.no_progress)
+        options = RunOptions(results=out, workers=args.workers, ray=args.ray, progress=shows_bars(args), sweep=sweep)
         outcome = run_suite(kind, suite, options, original)
         report = kind.report(outcome, out)[0]
     print(f"{suite.name}: {outcome.count} runs in {outcome.seconds:.1f} s; report {report}")
@@ -146,16 +175,24 @@ def run_on_data_seeds(args: argparse.Namespace, kind, suite, original, out: Path
         raise SettingsError(f"--data-seeds renders the data sets of episodes suites; '{suite.name}' is a "
                             f"{kind.name} suite")
     runs = {}
-    for seed in seeds:
-        folder = out / f"data-seed-{seed}"
-        with writing(folder, "results", inside=True):
-            folder.mkdir(parents=True, exist_ok=True)
-            one = suite.with_overrides(data_seed=seed)
-            options = RunOptions(results=folder, workers=args.workers, ray=args.ray, progress=not args.no_progress)
-            runs[seed] = run_suite(kind, one, options, original)
-            report = kind.report(runs[seed], folder)[0]
-        print(f"{suite.name} on data seed {seed}: {runs[seed].count} runs in {runs[seed].seconds:.1f} s; "
-              f"report {report}", flush=True)
+    with sweep_progress(args, kind, suite, out, len(seeds)) as sweep:
+        for seed in seeds:
+            folder = out / f"data-seed-{seed}"
+            if sweep is not None:
+                sweep.describe(f"data seed {seed}")
+            with writing(folder, "results", inside=True):
+                folder.mkdir(parents=True, exist_ok=True)
+                one = suite.with_overrides(data_seed=seed)
+                options = RunOptions(results=folder, workers=args.workers, ray=args.ray, progress=shows_bars(args),
+                                     sweep=sweep)
+                runs[seed] = run_suite(kind, one, options, original)
+                report = kind.report(runs[seed], folder)[0]
+            done = (f"{suite.name} on data seed {seed}: {runs[seed].count} runs in {runs[seed].seconds:.1f} s; "
+                    f"report {report}")
+            if isinstance(sweep, SweepProgress):
+                sweep.note(done)
+            else:
+                print(done, flush=True)
     pooled = pooled_findings(suite, runs)
     words = ["teachbot", "regress", "--suite", str(args.suite), "--data-seeds", *map(str, seeds)]
     for option, values in (("--strategies", args.strategies), ("--seeds", args.seeds), ("--datasets", args.datasets)):

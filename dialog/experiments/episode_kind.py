@@ -46,10 +46,11 @@ class EpisodesKind(SuiteKind):
                        data_seed=suite.data_seed)
         specs = episode_specs(suite, options.results)
         sweep_started = time.perf_counter()
+        progress = options.progress if options.sweep is None else options.sweep
         if options.ray:
-            results = run_on_ray(specs, options.ray, options.progress)
+            results = run_on_ray(specs, options.ray, progress)
         else:
-            results = run_locally(specs, options.workers, options.progress)
+            results = run_locally(specs, options.workers, progress)
         sweep = SweepUse(len(results), time.perf_counter() - sweep_started,
                          sum(r["cpu_seconds"] for r in results), os.cpu_count() or 1)
         summaries = summarise(results, suite)

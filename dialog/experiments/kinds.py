@@ -22,18 +22,24 @@ from typing import Any, ClassVar
 
 from dialog.experiments.analysis import CheckpointSummary, FindingResult, skipped_by_overrides
 from dialog.experiments.baseline import BaselineFailures, check_against_baseline
+from dialog.experiments.progress import Progress
 from dialog.experiments.registry import kind_names, registered
 from dialog.experiments.suite import Suite, SuiteError
 
 
 @dataclass(frozen=True)
 class RunOptions:
-    """How to run a suite: where its files go, worker processes, a Ray cluster, a progress bar."""
+    """How to run a suite: where its files go, worker processes, a Ray cluster, progress shown.
+
+    ``progress``: bars and lines at all (rendering the data sets, the episodes); ``sweep``: the progress line
+    the episodes advance when it is shared with a longer run (``dialog.experiments.progress``; None: the
+    suite's own line)."""
 
     results: Path
     workers: int | None = None
     ray: str | None = None
     progress: bool = True
+    sweep: Progress | None = None
 
 
 @dataclass(frozen=True)
@@ -103,7 +109,11 @@ def get_kind(name: str) -> SuiteKind:
     kinds = registered()
     if name not in kinds:
         raise SuiteError(f"unknown suite kind '{name}'; registered kinds: {', '.join(names)}")
-    return kinds[name]
+    kind = kinds[name]
+    if not isinstance(kind, SuiteKind):
+        raise TypeError(f"the suite kind registered as '{name}' ({type(kind).__name__}) is not a SuiteKind "
+                        "subclass (dialog.experiments.kinds.SuiteKind)")
+    return kind
 
 
 def run_suite(kind: SuiteKind, suite: Suite, options: RunOptions, original: Suite | None = None) -> SuiteRun:

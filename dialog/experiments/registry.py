@@ -1,24 +1,24 @@
 """The registry of suite kinds, by name: filled by ``register_kind``, the built-in kinds loaded when first asked for.
 
-It imports no suite kind itself, so that the suite file reader (``dialog.experiments.suite``) can check a
-suite's ``kind`` against it while every kind module imports that reader.
+It imports no suite module at all, not even for its types: the suite file reader (``dialog.experiments.suite``)
+checks a suite's ``kind`` against it, and the kinds (``dialog.experiments.kinds``, which imports that reader)
+register here, so a name of theirs here would close a circle. The registry holds any class with a ``name``;
+``dialog.experiments.kinds.get_kind`` checks that what it hands out is a ``SuiteKind``.
 """
 
 from __future__ import annotations
 
 import importlib
-from typing import TYPE_CHECKING
-
-if TYPE_CHECKING:
-    from dialog.experiments.kinds import SuiteKind
+from typing import Any, TypeVar
 
 BUILTIN_KIND_MODULES = ("dialog.experiments.episode_kind", "dialog.experiments.features.kind",
                         "dialog.experiments.recipes.kind")
 
-_KINDS: dict[str, SuiteKind] = {}  # name -> the registered kind, built-in ones first
+Kind = TypeVar("Kind", bound=type)
+_KINDS: dict[str, Any] = {}  # name -> an instance of the registered kind, built-in ones first
 
 
-def register_kind(kind: type[SuiteKind]) -> type[SuiteKind]:
+def register_kind(kind: Kind) -> Kind:
     """Register a ``SuiteKind`` subclass under its ``name`` (usable as a class decorator)."""
     name = getattr(kind, "name", "")
     if not isinstance(name, str) or not name:
@@ -40,7 +40,7 @@ def kind_names() -> tuple[str, ...]:
     return tuple(_KINDS)
 
 
-def registered() -> dict[str, SuiteKind]:
+def registered() -> dict[str, Any]:
     """The registered kinds by name (the built-in ones loaded first)."""
     _load_builtin_kinds()
     return _KINDS

@@ -1,17 +1,20 @@
-"""Run a suite's episodes on local cores (with a progress bar) or on a Ray cluster."""
+"""Run a suite's episodes on local cores or on a Ray cluster, with a progress line (``progress.py``)."""
 
 from __future__ import annotations
 
 import os
 import signal
 import sys
+import tempfile
 import threading
 import time
 from collections.abc import Callable
 from concurrent.futures import ProcessPoolExecutor, as_completed
+from dataclasses import replace
 from pathlib import Path
 
 from dialog.experiments.episodes import EpisodeSpec, run_episode
+from dialog.experiments.progress import Progress, SweepProgress
 from dialog.experiments.suite import Suite
 from learning.actions import DEFAULT_COSTS
 from learning.errors import SetupError
@@ -37,7 +40,11 @@ def episode_specs(suite: Suite, results_dir: Path) -> list[EpisodeSpec]:
     return specs
 
 
-def run_locally(specs: list[EpisodeSpec], workers: int | None = None, progress: bool = True) -> list[dict]:
+ProgressOption = bool | Progress  # True: a line of its own; False: none; a Progress: a line shared with a longer run
+
+
+def run_locally(specs: list[EpisodeSpec], workers: int | None = None,
+                progress: ProgressOption = True) -> list[dict]:
     """Run episodes in worker processes; results come back in the order of ``specs``."""
     workers = max(1, min(workers or os.cpu_count() or 1, len(specs)))
     results: list[dict | None] = [None] * len(specs)
@@ -56,19 +63,34 @@ def run_locally(specs: list[EpisodeSpec], workers: int | None = None, progress: 
     return results
 
 
-def run_on_ray(specs: list[EpisodeSpec], address: str, progress: bool = True) -> list[dict]:
-    """Run the same episodes as Ray tasks on the cluster at ``address`` ("local" starts one here)."""
+def run_on_ray(specs: list[EpisodeSpec], address: str, progress: ProgressOption = True) -> list[dict]:
+    """Run the same episodes as Ray tasks on the cluster at ``address`` ("local" starts one here); each
+    transcript comes back with its result and is written here, wherever the episode ran."""
     ray = connect_ray(address)
-    remote_episode = ray.remote(run_episode)
+    remote_episode = ray.remote(episode_on_node)
     pending = {remote_episode.remote(spec): i for i, spec in enumerate(specs)}
     results: list[dict | None] = [None] * len(specs)
     with _progress(len(specs), progress) as advance:
         while pending:
             done, _ = ray.wait(list(pending), num_returns=1)
             index = pending.pop(done[0])
-            results[index] = ray.get(done[0])
+            results[index], transcript = ray.get(done[0])
+            path = Path(specs[index].transcript)
+            path.parent.mkdir(parents=True, exist_ok=True)
+            path.write_bytes(transcript)
             advance(specs[index].label)
     return results
+
+
+def episode_on_node(spec: EpisodeSpec) -> tuple[dict, bytes]:
+    """One episode on a cluster node: its transcript is written in the node's temporary folder (the driver's
+    results folder may not exist there) and sent back as bytes with the result."""
+    with tempfile.TemporaryDirectory(prefix="teachbot-episode-") as folder:
+        here = replace(spec, transcript=str(Path(folder) / Path(spec.transcript).name))
+        result = run_episode(here)
+        transcript = Path(here.transcript).read_bytes()
+    result["spec"]["transcript"] = spec.transcript
+    return result, transcript
 
 
 def connect_ray(address: str, command: str = "regress"):
@@ -143,27 +165,24 @@ def _check_token_mode(ray) -> None:
 
 
 class _progress:
-    """A rich progress bar on standard error (kept off standard output, which may carry JSON)."""
+    """The progress of ``total`` runs: a run's own line (``enabled`` True), none (False), or a line shared with
+    the rest of a longer run (a ``dialog.experiments.progress`` object, which its owner closes)."""
 
-    def __init__(self, total: int, enabled: bool):
-        self.total, self.enabled = total, enabled
+    def __init__(self, total: int, enabled: ProgressOption, what: str = "episodes"):
+        self.total, self.enabled, self.what = total, enabled, what
+        self._own: SweepProgress | None = None
 
     def __enter__(self) -> Callable[[str], None]:
-        if not self.enabled:
+        if self.enabled is False:
             return lambda label: None
-        from rich.console import Console
-        from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
-
-        console = Console(file=sys.stderr)
-        self._bar = Progress(TextColumn("episodes"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
-                             TextColumn("{task.description}"), console=console, transient=not console.is_terminal)
-        self._bar.start()
-        task = self._bar.add_task("", total=self.total)
-        return lambda label: self._bar.update(task, advance=1, description=label)
+        shared = self.enabled if not isinstance(self.enabled, bool) else None
+        if shared is None:
+            self._own = shared = SweepProgress(self.total, self.what)
+        return lambda label: shared.advance()
 
     def __exit__(self, *exc) -> None:
-        if self.enabled:
-            self._bar.stop()
+        if self._own is not None:
+            self._own.close()
 
 
 class RenderBar:

@@ -119,6 +119,18 @@ def test_a_registered_kind_is_run_by_the_command(tmp_path, capsys, monkeypatch):
     assert (tmp_path / "out" / "report.md").read_text() == "counted a, b"
 
 
+def test_the_registry_hands_out_only_suite_kinds(monkeypatch):
+    """The registry names no suite type (issue 43: no import circle); get_kind checks what it hands out."""
+    class NotAKind:
+        name = "not-a-kind"
+
+    monkeypatch.setattr(registry, "_KINDS", dict(registry._KINDS))
+    registry.register_kind(NotAKind)
+    with pytest.raises(TypeError, match="'not-a-kind' \\(NotAKind\\) is not a SuiteKind"):
+        kinds.get_kind("not-a-kind")
+    assert isinstance(kinds.get_kind("episodes"), kinds.SuiteKind)
+
+
 def test_a_strategy_subset_reports_the_findings_it_skips_and_why(tmp_path):
     original = load_suite(suite_file(tmp_path))
     suite = original.with_overrides(strategies=["passive", "active"])

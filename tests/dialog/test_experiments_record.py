@@ -85,6 +85,9 @@ def test_a_run_writes_stamped_tables_from_its_own_files(tmp_path):
     assert done.returncode == 0, done.stderr
     manifest = json.loads(done.stdout.strip().splitlines()[-1])
     assert manifest["runs"]["smoke"]["episodes"] == 12 and manifest["cores"] >= 1
+    progress = [line for line in done.stderr.splitlines() if line.startswith("episodes ")]
+    assert progress and progress[-1].startswith("episodes 12/12 (100%)"), done.stderr  # the run's one line
+    assert all("/12 " in line for line in progress) and "teachbot-progress" not in done.stderr + done.stdout
     text = doc.read_text()
     assert "STALE TEXT" not in text and unstamped_tables(text) == []
     replication = json.loads((results / "smoke" / "replication.json").read_text())

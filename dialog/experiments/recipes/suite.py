@@ -223,7 +223,7 @@ def run_recipe_suite(study: RecipeStudy, workers: int | None = None, progress: b
                 "trials": study.execution_trials if study.runs("execution") else 0, "execution_m": study.demos,
                 "grasp": study.grasp, "tau": study.tau}
                for seed in study.seeds for recipe in study.recipes for kitchen in study.kitchens]
-    with _progress(len(collect), progress) as advance:
+    with _progress(len(collect), progress, "collections") as advance:
         collected = _run_all(collect, min(workers, len(collect)), advance)
     demos = {(c["seed"], c["recipe"], c["kitchen"]): c["demos"] for c in collected}
     jobs = []
@@ -239,7 +239,7 @@ def run_recipe_suite(study: RecipeStudy, workers: int | None = None, progress: b
             jobs += [{"kind": "transfer", "seed": seed, "recipe": recipe, "kitchen": kitchen, "demos": every, "m": m,
                       "repeats": study.transfer_repeats} for m in study.transfer_m]
     jobs.sort(key=lambda job: -_cost(job))  # longest first: the pool ends together
-    with _progress(len(jobs), progress) as advance:
+    with _progress(len(jobs), progress, "trials") as advance:
         done = _run_all(jobs, min(workers, max(1, len(jobs))), advance)
     grouped: dict[str, list[dict]] = {"collect": [{k: v for k, v in c.items() if k != "demos"} for c in collected],
                                       "cv": [], "pairs": [], "transfer": []}
