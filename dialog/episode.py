@@ -22,7 +22,7 @@ from dialog.settings import EpisodeSettings
 from dialog.teachers.protocol import Teacher
 from dialog.teachers.scripted import SCRIPTED_OPTIONS, OracleTeacher, ReplayTeacher, ScriptedTeacher
 from dialog.teachers.terminal import TerminalTeacher
-from dialog.transcripts.jsonl import read_session
+from dialog.transcripts.records import read_replay_records
 from learning.errors import SettingsError
 
 TEACHER_KINDS = ("terminal", "scripted", "oracle", "replay")
@@ -49,7 +49,7 @@ def make_teacher(kind: str, *, rng: np.random.Generator | None = None, clock=Non
     if kind == "replay":
         if not transcript:
             raise SettingsError("a replay teacher needs the transcript to replay (--replay FILE)")
-        return ReplayTeacher(read_session(transcript)[1])
+        return ReplayTeacher(read_replay_records(transcript))
     if rng is None:
         raise TypeError(f"a {kind} teacher needs its random generator (rng=)")
     if kind == "oracle":

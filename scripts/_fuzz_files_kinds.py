@@ -10,6 +10,7 @@ or swapped line) may or may not leave a valid file; for them only tracebacks, ha
 from __future__ import annotations
 
 import json
+import os
 import sys
 from pathlib import Path
 
@@ -196,11 +197,59 @@ TRANSCRIPT_RULES = [
     ("a turn line duplicated", duplicate_line),
     ("a record [1,2,3]", lambda p, rng: p.write_text(p.read_text() + "[1,2,3]\n")),
 ]
+def drop_field(line, key):
+    """Remove a field of the JSON record on ``line`` (a turn written without its answer, say)."""
+    def apply(path, rng):
+        lines = path.read_text(encoding="utf-8").splitlines(keepends=True)
+        record = json.loads(lines[line])
+        record.pop(key, None)
+        lines[line] = json.dumps(record, ensure_ascii=False) + "\n"
+        path.write_text("".join(lines), encoding="utf-8")
+    return apply
+
+
+def torn_after_a_turn(path, rng):
+    """Keep the header and the first turns, and a torn piece of the next line: a transcript that lost turns."""
+    lines = _lines(path)
+    keep = int(rng.integers(1, len(lines)))
+    path.write_bytes(b"".join(lines[:keep]) + lines[keep][:int(rng.integers(0, len(lines[keep]) - 1))])
+
+
+def lone_surrogate(line, key_path):
+    """A JSON escape of half a surrogate pair (``"\\ud800zz"``) in a text field: valid JSON, not Unicode text."""
+    def apply(path, rng):
+        lines = path.read_text(encoding="utf-8").splitlines(keepends=True)
+        index = line if line >= 0 else len(lines) + line
+        record = json.loads(lines[index])
+        _set(record, key_path, ["\ud800zz"] if key_path[-1] == "lines" else "\ud800zz")
+        lines[index] = json.dumps(record, ensure_ascii=True) + "\n"  # the escape, as a page's JSON carries it
+        path.write_text("".join(lines), encoding="utf-8")
+    return apply
+
+
+def device_link(path, rng):
+    path.unlink()
+    path.symlink_to("/dev/zero")  # never ends: a reader must refuse it before reading
+
+
+def fifo(path, rng):
+    path.unlink()
+    os.mkfifo(path)  # blocks a reader that opens it: it must be refused unopened
+
+
 STUDY_TRANSCRIPT_RULES = TRANSCRIPT_RULES + [
     ("header strategy of another condition", set_record(0, ("session", "strategy"), ["active", "passive"])),
     ("header seed edited", set_record(0, ("session", "seed"), [1, 12345])),
     ("header participant edited", set_record(0, ("session", "study", "participant"), ["P02", "P01\n"])),
     ("accuracy out of range", set_record(2, ("accuracy",), [7, -1, "x"])),
+    # issue 42: the questionnaire beside it rated the whole session; every header field is the study run's
+    ("torn after a turn, beside the questionnaire", torn_after_a_turn),
+    ("a turn without its answer", drop_field(2, "answer")),
+    ("header software edited", set_record(0, ("session", "study", "software"), ["hacked", 5, "", None])),
+    ("header teacher edited", set_record(0, ("session", "teacher"), [{"kind": "terminal"}, {"kind": "replay"}])),
+    ("header costs edited", set_record(0, ("session", "costs"), [{"label": 0, "demo": 0, "feature": 0, "none": 0}])),
+    ("header unknown field", set_record(0, ("session", "zz_unknown"), [1])),
+    ("an answer line a lone surrogate", lone_surrogate(1, ("answer", "lines"))),
 ]
 QUESTIONNAIRE_RULES = [
     ("Likert 'seven'", set_record(1, ("value",), ["seven", 99, 0, True, 2.5])),
@@ -212,6 +261,18 @@ QUESTIONNAIRE_RULES = [
     ("an answer duplicated", duplicate_line),
     ("an answer removed", lambda p, rng: p.write_text("".join(p.read_text().splitlines(keepends=True)[:-1]))),
     ("a line [1,2,3]", lambda p, rng: p.write_text(p.read_text() + "[1,2,3]\n")),
+    ("text a lone surrogate", lone_surrogate(-1, ("value",))),
+    ("header software edited", set_record(0, ("questionnaire", "software"), ["hacked", 5, None])),
+]
+REPLAY_RULES = [  # a transcript given to teach --teacher replay --replay
+    ("a link to /dev/zero", device_link),
+    ("a FIFO", fifo),
+    ("answer not a table", set_record(1, ("answer",), [RECORD, "a fruit", None])),
+    ("answer lines not a list", set_record(1, ("answer", "lines"), ["a fruit", [1], {"x": 1}])),
+    ("turn not a number", set_record(1, ("turn",), ["three", 0, True, None])),
+    ("a turn line duplicated", duplicate_line),
+    ("an answer line a lone surrogate", lone_surrogate(1, ("answer", "lines"))),
+    ("a record [1,2,3]", lambda p, rng: p.write_text(p.read_text() + "[1,2,3]\n")),
 ]
 NOTE_RULES = [
     ("after_turns not a count", set_record(0, ("aborted", "after_turns"), ["abc", [1], -1, 999, None])),

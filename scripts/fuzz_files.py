@@ -3,14 +3,16 @@
     python scripts/fuzz_files.py --cases 300 --json
 
 Kinds: the study file, a suite, DT weights, a questioner policy (its TOML and its NPZ), a kitchen and a task file,
-a teach transcript, a study session's transcript, its questionnaire answers and an abort note, IRL
-demonstrations, and hostile output paths (FIFOs, devices, folders, names and paths too long, a loop of links,
-``newdir/``, /proc). Each case copies good files made once at the start (a simulated study participant, a
-scripted teach session, ...), applies one mutation (``_fuzz_files_kinds``), and runs the reading command as a
-subprocess with a timeout. Counted: tracebacks, hangs (the timeout), silent accepts (a mutation that breaks a
-stated rule taken without a refusal; for study records, ``study status`` must mark the session damaged) and
-recorded bytes lost (the complete lines of every recorded file must still be there afterwards, or in a
-``*.superseded-N`` copy). The same --seed gives the same cases. The last line (with --json) is one JSON object.
+a teach transcript (resumed, and given to a replay teacher with --replay, also as a link to /dev/zero or a
+FIFO), a study session's transcript (torn or answer-less beside its questionnaire, headers edited), its
+questionnaire answers (lone surrogates in text) and an abort note, IRL demonstrations, and hostile output
+paths (FIFOs, devices, folders, names and paths too long, a loop of links, ``newdir/``, /proc). Each case
+copies good files made once at the start (a simulated study participant, a scripted teach session, ...), applies
+one mutation (``_fuzz_files_kinds``), and runs the reading command as a subprocess with a timeout. Counted:
+tracebacks, hangs (the timeout), silent accepts (a mutation that breaks a stated rule taken without a refusal;
+for study records, ``study status`` must mark the session damaged) and recorded bytes lost (the complete lines
+of every recorded file must still be there afterwards, or in a ``*.superseded-N`` copy). The same --seed gives
+the same cases. The last line (with --json) is one JSON object.
 """
 
 from __future__ import annotations
@@ -84,6 +86,8 @@ def make_kinds(conditions) -> list[Kind]:
         Kind("task", "world", "task.toml", [["world", "show", "--task", "task.toml"]], toml_rules()),
         Kind("transcript", "teach", "t.jsonl", [["teach", "--resume", "t.jsonl", "--no-pictures"]],
              kinds.TRANSCRIPT_RULES, recorded="t.jsonl*"),
+        Kind("replay", "teach", "t.jsonl", [["teach", "--teacher", "replay", "--replay", "t.jsonl", "--turns", "4",
+                                             "--no-pictures", "--transcript", "replayed.jsonl"]], kinds.REPLAY_RULES),
         Kind("study-transcript", "study", f"{first}.jsonl", [status, run1], kinds.STUDY_TRANSCRIPT_RULES,
              recorded="d/**/*", damaged=f"damaged: P01 session 1 ({conditions[0]})"),
         Kind("questionnaire", "study", f"{first}-questionnaire.jsonl", [status, run1], kinds.QUESTIONNAIRE_RULES,

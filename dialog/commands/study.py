@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import shlex
 from pathlib import Path
 
 
@@ -112,10 +113,27 @@ def _run(args) -> int:
         page.close()
 
 
+def _dry_run_note(args, study, action: str) -> str:
+    """One line when the study's records folder holds no session but its dry-run folder does: where the
+    simulated sessions are, and the exact command that reads them ('' otherwise)."""
+    if args.simulated or args.folder is not None or any(study.folder.glob("*/*.jsonl")):
+        return ""
+    dry = study.folder.with_name(study.folder.name + SIMULATED_SUFFIX)
+    if not any(dry.glob("*/*.jsonl")):
+        return ""
+    command = shlex.join(["teachbot", "study", action, str(args.study), "--simulated"])
+    return (f"note: no session is recorded in {study.folder}; the simulated sessions (study run --simulated) are "
+            f"in {dry}: {command}")
+
+
 def _status(args) -> int:
     from dialog.study.status import status_text
 
-    print(status_text(_load(args)), flush=True)
+    study = _load(args)
+    print(status_text(study), flush=True)
+    note = _dry_run_note(args, study, "status")
+    if note:
+        print(note, flush=True)
     return 0
 
 
@@ -126,4 +144,7 @@ def _report(args) -> int:
     written = write_report(study, args.out or study.folder / "report", allow_mixed=args.allow_mixed)
     for path in written:
         print(path)
+    note = _dry_run_note(args, study, "report")
+    if note:
+        print(note, flush=True)
     return 0

@@ -18,7 +18,13 @@ from pathlib import Path
 
 from dialog import software_version
 from dialog.output_paths import superseded_name, writing
-from dialog.study.records import expected_session, read_abort_note, read_questionnaire, read_study_transcript
+from dialog.study.records import (
+    expected_session,
+    read_abort_note,
+    read_questionnaire,
+    read_study_transcript,
+    torn_tail,
+)
 from learning import datafiles as df
 from learning.errors import OutputPathError, TeachbotError, TranscriptError
 
@@ -54,7 +60,9 @@ class SessionFiles:
 
     @property
     def pictures(self) -> Path:
-        return self.folder / f"{self.stem}-pictures"
+        """The session's scene pictures: named by position only, since the participant sees their paths
+        (``Picture: ...``) and nothing a participant sees may name the condition (docs/studies.md)."""
+        return self.folder / f"{self.order}-pictures"
 
     def existing(self) -> list[Path]:
         return [path for path in (self.transcript, self.questionnaire, self.aborted) if path.exists()]
@@ -107,18 +115,25 @@ def _state(files: SessionFiles, condition, expected: dict, session: dict, items)
         return SessionState("aborted", note["after_turns"], note["reason"])
     if not _has_content(files.transcript):
         if answered:
-            gone = "empty" if files.transcript.exists() else "missing"
-            raise TranscriptError(f"{files.transcript}: the transcript is {gone}, "
-                                  f"but the questionnaire after it is recorded in {files.questionnaire.name}; restore "
-                                  "the transcript, or run the condition again with --condition "
-                                  f"{files.condition} --again (every record is kept, renamed *.superseded-N)")
+            _refuse_unfinished(files, "is " + ("empty" if files.transcript.exists() else "missing"))
         return SessionState("missing")
     _, records = read_transcript_checked(files, expected, session)
+    if answered and (len(records) < condition.turns or torn_tail(files.transcript)):
+        # the questionnaire is asked only once the last turn is on disk: this transcript lost turns since
+        torn = f", and line {len(records) + 2} is torn" if torn_tail(files.transcript) else ""
+        _refuse_unfinished(files, f"ends after turn {len(records)} of {condition.turns}{torn}")
     if len(records) < condition.turns:
         return SessionState("running", len(records))
     if items and not answered:
         return SessionState("questionnaire", len(records))
     return SessionState("done", len(records))
+
+
+def _refuse_unfinished(files: SessionFiles, how: str) -> None:
+    raise TranscriptError(f"{files.transcript}: the transcript {how}, but the questionnaire after it is recorded in "
+                          f"{files.questionnaire.name} (it is asked only once the whole session is on disk); restore "
+                          f"the transcript, or run the condition again with --condition {files.condition} --again "
+                          "(every record is kept, renamed *.superseded-N)")
 
 
 def session_state_of(study, participant: str, position: int, name: str) -> SessionState:
@@ -136,26 +151,30 @@ def write_atomically(path: Path, text: str, what: str, *, replace: bool = True) 
     """Write ``text`` to ``path`` through a temporary file and a rename: the record is there whole or not at all.
 
     With ``replace=False`` (recorded answers) an existing ``path`` is never written over: the temporary file
-    is linked into place, which fails if the name is taken, and the refusal names the file.
+    is linked into place, which fails if the name is taken, and the refusal names the file. The temporary file
+    is removed however the call ends; text that is not valid Unicode (a lone surrogate) is a ``ValueError``
+    before anything is opened (the callers check what people type first: ``questionnaire.text_problem``).
     """
+    data = text.encode("utf-8")  # text that can't be encoded fails here, before any file is opened
     temporary = path.with_name(f".{path.name}.tmp")
     with writing(path, what):
         path.parent.mkdir(parents=True, exist_ok=True)
-        with open(temporary, "w", encoding="utf-8") as handle:
-            handle.write(text)
-            handle.flush()
-            os.fsync(handle.fileno())
-        if replace:
-            os.replace(temporary, path)
-            return
         try:
-            os.link(temporary, path)
-        except FileExistsError:
-            raise OutputPathError(f"{path}: already holds the {what}; teachbot never writes over recorded "
-                                  "answers (run the condition again with --condition NAME --again to keep "
-                                  "them as *.superseded-N)") from None
-        finally:
-            os.unlink(temporary)
+            with open(temporary, "wb") as handle:
+                handle.write(data)
+                handle.flush()
+                os.fsync(handle.fileno())
+            if replace:
+                os.replace(temporary, path)
+                return
+            try:
+                os.link(temporary, path)
+            except FileExistsError:
+                raise OutputPathError(f"{path}: already holds the {what}; teachbot never writes over recorded "
+                                      "answers (run the condition again with --condition NAME --again to keep "
+                                      "them as *.superseded-N)") from None
+        finally:  # the temporary file never outlives the call, whatever happened
+            temporary.unlink(missing_ok=True)
 
 
 def supersede(files: SessionFiles) -> list[Path]:

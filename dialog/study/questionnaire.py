@@ -1,7 +1,9 @@
 """The questionnaire after a session: asked at the terminal (or answered by a simulated participant), then saved.
 
 A Likert item takes a whole number from 1 to its number of points (``skip``
-leaves it unanswered); a free-text item takes any line (empty: unanswered).
+leaves it unanswered); a free-text item takes any line of Unicode text (empty:
+unanswered); a line that is not text (a lone surrogate such as ``"\\ud800"``,
+which no file can hold as UTF-8) is refused where it is typed, and asked again.
 The answers are written together, once all are given, as JSON Lines: a
 ``questionnaire`` header (who, which condition, which position, which software)
 and one line per item; never over answers already recorded. They are read
@@ -13,6 +15,7 @@ from __future__ import annotations
 import json
 
 from dialog.study.files import write_atomically
+from dialog.transcripts.records import TEXT_ACCEPTED, text_problem
 
 SKIP_WORDS = ("skip", "pass", "-")
 
@@ -45,10 +48,16 @@ def ask_terminal(items, read_line, write) -> list[dict] | None:
                 write(f"   Please type a whole number from 1 to {item.points}, or 'skip'.")
         else:
             write(f"\n{number}. {item.text}\n   (any text; Enter alone leaves it out)")
-            write("> ", end="")
-            line = read_line()
-            if line is None:
-                return None
+            while True:
+                write("> ", end="")
+                line = read_line()
+                if line is None:
+                    return None
+                problem = text_problem(line)
+                if not problem:
+                    break
+                write(f"   That text can't be recorded ({problem}). Please type {TEXT_ACCEPTED}, or Enter alone "
+                      "to leave it out.")
             value = line.strip()[:2000] or None
         answers.append({"item": item.id, "kind": item.kind, "value": value})
     return answers
@@ -60,9 +69,15 @@ def ask_web(items, teacher) -> list[dict]:
     shown = [{"kind": "likert", "text": item.text, "low": 1, "high": item.points, "low_label": item.anchors[0],
               "high_label": item.anchors[1]} if item.kind == "likert" else {"kind": "text", "text": item.text}
              for item in items]
-    values = teacher.ask_screen("A few questions about this session", "Leave an item empty to leave it out.",
-                                "Save the answers", shown)
-    return [{"item": item.id, "kind": item.kind, "value": value} for item, value in zip(items, values)]
+    note = "Leave an item empty to leave it out."
+    while True:
+        values = teacher.ask_screen("A few questions about this session", note, "Save the answers", shown)
+        problems = [f"item {number}: {text_problem(value)}" for number, value in enumerate(values, start=1)
+                    if isinstance(value, str) and text_problem(value)]
+        if not problems:
+            return [{"item": item.id, "kind": item.kind, "value": value} for item, value in zip(items, values)]
+        note = (f"Those answers can't be recorded ({'; '.join(problems)}). Please give {TEXT_ACCEPTED}, or leave "
+                "an item empty to leave it out.")
 
 
 def ask_simulated(items, rng) -> list[dict]:

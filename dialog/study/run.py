@@ -31,6 +31,7 @@ from dialog.study.files import (
 from dialog.study.records import expected_session
 from dialog.teachers.terminal import LineReader
 from dialog.transcripts.lock import TranscriptLock
+from dialog.transcripts.records import TEXT_ACCEPTED, text_problem
 from learning.errors import OutputPathError, TranscriptError
 
 
@@ -110,7 +111,11 @@ class ParticipantRun:
                 finally:
                     if lock is not None:
                         lock.release()
-                self.write(f"Kept the earlier records as {', '.join(p.name for p in moved)}.")
+                if self.show_conditions:
+                    self.write(f"Kept the earlier records as {', '.join(p.name for p in moved)}.")
+                else:  # the file names name the condition
+                    self.write(f"Kept the earlier records of session {position} ({len(moved)} files, renamed "
+                               "*.superseded-N in the participant's folder).")
             return [position]
         if again:
             raise TranscriptError("--again needs --condition NAME: the one condition to run again")
@@ -127,6 +132,8 @@ class ParticipantRun:
         """Mark the participant's current session (the first not done) aborted, with the reason; it stays recorded."""
         if not reason.strip():
             raise TranscriptError("--abort needs a reason, e.g. --abort \"participant felt unwell\"")
+        if text_problem(reason):
+            raise TranscriptError(f"--abort's reason can't be recorded ({text_problem(reason)}); give {TEXT_ACCEPTED}")
         for position, state in enumerate(self.states(), start=1):
             if state.state in ("done", "aborted"):
                 continue

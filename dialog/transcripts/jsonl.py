@@ -12,12 +12,15 @@ import json
 import os
 from pathlib import Path
 
-from dialog.output_paths import writing
+from dialog.output_paths import path_problem, special_file, writing
 from dialog.transcripts.lock import TranscriptLock
 from learning.errors import OutputPathError, TranscriptError
+from learning.limits import maximum
 
 FORMAT = "teachbot-transcript"
 VERSION = 1
+TURN_BYTES = 16 << 10  # room for one turn record (a few kB: question, answer lines, model summary)
+MAX_TRANSCRIPT_BYTES = int(maximum("turns")) * TURN_BYTES  # the turns limit (learning/data/limits.toml) times that
 
 
 class TranscriptWriter:
@@ -145,6 +148,7 @@ def read_numbered_session(path: str | Path, tolerate_partial_tail: bool = False
     line without a newline when ``tolerate_partial_tail`` (a crash mid-write).
     """
     header, records = None, []
+    check_transcript_file(path)
     try:
         with open(path, encoding="utf-8", errors="replace") as handle:
             lines = handle.readlines()
@@ -180,6 +184,27 @@ def read_numbered_session(path: str | Path, tolerate_partial_tail: bool = False
             raise TranscriptError(f"{path}: line {number} has no 'turn'")
         records.append((number, record))
     return header, records
+
+
+def check_transcript_file(path: str | Path) -> None:
+    """Refuse, before opening it, a transcript to read that is not a regular file of at most
+    :data:`MAX_TRANSCRIPT_BYTES` (a FIFO would block, ``/dev/zero`` never ends): the checks output paths get
+    (``dialog.output_paths``), for ``--resume``, ``--replay`` and a study's records alike."""
+    problem = path_problem(path)
+    if problem:
+        raise TranscriptError(f"{str(path)[:160]}: cannot be read: {problem}")
+    kind = special_file(path)
+    if kind:
+        raise TranscriptError(f"{path}: it is {kind}, not a regular file; give a transcript file that teachbot wrote "
+                              "(nothing was read)")
+    try:
+        size = os.stat(path).st_size
+    except OSError:
+        return  # missing, or not allowed: the reader says so in its words
+    if size > MAX_TRANSCRIPT_BYTES:
+        raise TranscriptError(f"{path}: {size:,} bytes is more than a transcript holds (at most "
+                              f"{MAX_TRANSCRIPT_BYTES:,} bytes: {MAX_TRANSCRIPT_BYTES // TURN_BYTES:,} turns of "
+                              f"{TURN_BYTES:,} bytes); give a transcript file that teachbot wrote")
 
 
 def json_problem(error: json.JSONDecodeError, line: str) -> str:

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 
 import numpy as np
 
@@ -22,6 +23,18 @@ from learning.errors import TranscriptError
 
 ANSWER_KINDS = ("answer", "absent", "skip", "dont_know", "late", "none")
 CHANNELS = ("typed", "button", "click")  # how a page's answer line came (dialog/web/messages.py makes them)
+SURROGATE = re.compile("[\ud800-\udfff]")
+TEXT_ACCEPTED = "any Unicode text (letters, digits, punctuation, emoji)"
+
+
+def text_problem(text: str) -> str:
+    """Why typed text can't be recorded ('' when it can): a lone surrogate (``"\\ud800"``, which a JSON
+    escape or a page can carry) is no Unicode character, and no UTF-8 file can hold it."""
+    found = SURROGATE.search(text)
+    if found is None:
+        return ""
+    return (f"character {found.start() + 1} is U+{ord(found.group()):04X}, half of a surrogate pair, which is not a "
+            "character of its own")
 
 
 def action_record(action: Action) -> dict:
@@ -93,6 +106,30 @@ def outcome_from_record(record: dict, action: Action, feature_names) -> Outcome:
         else:
             value = parsed
     return Outcome(kind, value, list(answer.get("lines", [])), float(answer.get("seconds", 0.0)))
+
+
+def read_replay_records(path) -> list[dict]:
+    """The turn records a replay teacher answers from (``teach --teacher replay --replay FILE``): the file passes
+    the checks every transcript read does (a regular file, not too large, JSON Lines), and each record has a
+    turn number, once, and typed lines; anything else is refused as ``FILE: line N: ... (expected ...)``."""
+    from dialog.transcripts.jsonl import read_numbered_session
+
+    _, numbered = read_numbered_session(path)
+    seen: set[int] = set()
+    for line, record in numbered:
+        try:
+            turn, answer = record.get("turn"), record.get("answer", {})
+            if not _is_int(turn) or turn < 1 or turn in seen:
+                raise _refuse("turn", turn, "a whole number from 1, once per turn")
+            seen.add(turn)
+            if not isinstance(answer, dict):
+                raise _refuse("answer", answer, "a table with the lines the teacher typed")
+            lines = answer.get("lines", [])
+            if not isinstance(lines, list) or not all(isinstance(x, str) and not text_problem(x) for x in lines):
+                raise _refuse("answer.lines", lines, f"a list of the lines the teacher typed, each {TEXT_ACCEPTED}")
+        except TranscriptError as error:
+            raise TranscriptError(f"{path}: line {line}: {error}") from None
+    return [record for _, record in numbered]
 
 
 # -- checking a recorded turn before it is replayed -------------------------------------------------------------
@@ -173,8 +210,8 @@ def _check_answer(answer, action: str, concepts, feature_names) -> None:
         if unknown:
             raise _refuse("answer.parsed", unknown, "names from this session's feature catalogue")
     lines = answer.get("lines", [])
-    if not isinstance(lines, list) or not all(isinstance(line, str) for line in lines):
-        raise _refuse("answer.lines", lines, "a list of the lines the teacher typed")
+    if not isinstance(lines, list) or not all(isinstance(line, str) and not text_problem(line) for line in lines):
+        raise _refuse("answer.lines", lines, f"a list of the lines the teacher typed, each {TEXT_ACCEPTED}")
     seconds = answer.get("seconds", 0.0)
     if not (_is_number(seconds) and seconds >= 0):
         raise _refuse("answer.seconds", seconds, "zero or more seconds")

@@ -2,6 +2,8 @@
 
 import argparse
 import json
+import os
+import stat
 import subprocess
 import sys
 from pathlib import Path
@@ -67,8 +69,8 @@ def small_run(tmp_path_factory):
 def test_a_small_run_covers_every_kind_and_finds_nothing_in_the_file_and_path_readers(small_run):
     assert small_run["cases"] == 26 and set(COUNTS) <= set(small_run)
     assert sorted(small_run["per_kind"]) == sorted(
-        ["study", "suite", "weights", "policy", "policy-npz", "kitchen", "task", "transcript", "study-transcript",
-         "questionnaire", "study-note", "demonstrations", "paths"])
+        ["study", "suite", "weights", "policy", "policy-npz", "kitchen", "task", "transcript", "replay",
+         "study-transcript", "questionnaire", "study-note", "demonstrations", "paths"])
     found = {kind: {name: counts[name] for name in COUNTS if counts[name]}
              for kind, counts in small_run["per_kind"].items() if kind not in OTHER_AREAS}
     assert not any(found.values()), (found, small_run["examples"])
@@ -87,7 +89,30 @@ def test_the_same_seed_mutates_the_same_files_the_same_way(tmp_path):
                 continue
             folder = tmp_path / attempt / str(spec[0])
             case = fuzzer.prepare(spec, by_name, folder)
-            mutated.append((case.kind, case.mutation, case.breaks_rule,
-                            (folder / by_name[case.kind].target).read_bytes()))
+            mutated.append((case.kind, case.mutation, case.breaks_rule, _content(folder / by_name[case.kind].target)))
         runs.append(mutated)
-    assert runs[0] == runs[1] and len(runs[0]) == 24
+    assert runs[0] == runs[1] and len(runs[0]) == 25
+
+
+def _content(path: Path):
+    """A mutated file's bytes; a link's target and a FIFO by kind (reading a FIFO would block)."""
+    if path.is_symlink():
+        return ("link", os.readlink(path))
+    return ("fifo",) if stat.S_ISFIFO(path.stat().st_mode) else path.read_bytes()
+
+
+def test_the_replay_and_study_mutations_of_issue_42_break_their_files_the_stated_way(tmp_path):
+    rng = np.random.default_rng(0)
+    record = {"turn": 1, "answer": {"lines": ["a fruit"], "kind": "answer"}}
+    path = tmp_path / "t.jsonl"
+    for rules in (kinds.REPLAY_RULES, kinds.STUDY_TRANSCRIPT_RULES):
+        names = dict(rules)
+        path.write_text(json.dumps({"session": {"study": {"software": "teachbot 0.1.0"}}}) + "\n" +
+                        json.dumps(record) + "\n" + json.dumps(record | {"turn": 2}) + "\n")
+        names["an answer line a lone surrogate"](path, rng)
+        assert '"lines": ["\\ud800zz"]' in path.read_text()
+    names["torn after a turn, beside the questionnaire"](path, rng)
+    assert not path.read_bytes().endswith(b"\n") or path.read_bytes().count(b"\n") < 3
+    for name, shown in (("a link to /dev/zero", ("link", "/dev/zero")), ("a FIFO", ("fifo",))):
+        dict(kinds.REPLAY_RULES)[name](path, rng)
+        assert _content(path) == shown

@@ -173,3 +173,70 @@ def test_participants_see_no_condition_strategy_or_budget_unless_a_pilot_asks(tm
     else:
         assert [word for word in revealing if word in shown] == []
         assert "Robot stays quiet." in shown  # the quiet turns, without the reason that names the budget
+
+
+BLIND_STUDY = """
+name = "blind"
+seed = 11
+ids = ["B01"]
+order = "given"
+folder = "records"
+pause = "Take a short break now."
+[orders]
+B01 = ["cond-alpha", "cond-beta"]
+[[conditions]]
+name = "cond-alpha"
+strategy = "active"
+task = "sort-groceries"
+turns = 2
+budget = 5
+instructions = "Teach the robot what it points at."
+[[conditions]]
+name = "cond-beta"
+strategy = "all-cd"
+task = "serve-salad"
+turns = 2
+budget = 5
+instructions = "Teach the robot again."
+[[questionnaire]]
+id = "ease"
+kind = "likert"
+text = "Teaching was easy."
+points = 5
+anchors = ["disagree", "agree"]
+"""
+#: what names a condition: its name, its strategy, its task, and file names made of them (issue 42 case 3)
+CONDITION_WORDS = (r"cond-alpha", r"cond-beta", r"\bactive\b", r"all-cd", r"sort-groceries", r"serve-salad",
+                   r"1-cond", r"2-cond")
+
+
+def test_nothing_a_participant_sees_at_the_terminal_names_a_condition(tmp_path):
+    """``--no-viewer`` sessions show each question's picture path (``Picture: ...``): it used to be
+    ``records/B01/1-cond-alpha-pictures/...``, naming the condition the browser study hides."""
+    import io
+    import re
+
+    (tmp_path / "study.toml").write_text(BLIND_STUDY)
+    seen = io.StringIO()
+    child = spawn_study(tmp_path, "run", "study.toml", "--participant", "B01", "--no-viewer")
+    child.logfile_read = seen
+    child.expect_exact("Press Enter to begin.")
+    child.sendline("")
+    while child.expect(["What is the|Which features|Can you show", "1 = disagree"]) == 0:
+        child.expect("> ")
+        child.sendline("skip")  # every question of the session; then the questionnaire
+    child.expect("> ")
+    child.sendline("4")
+    child.expect_exact("Take a short break now.")
+    child.sendline("")
+    child.expect_exact("=== Session 2 of 2 ===")
+    child.expect_exact("Press Enter to begin.")
+    child.sendeof()
+    child.expect(pexpect.EOF)
+    child.close()
+    shown = seen.getvalue()
+    assert "Picture: records/B01/1-pictures/scene-" in shown, shown  # the picture is still shown, by position
+    named = [word for word in CONDITION_WORDS if re.search(word, shown)]
+    assert not named, (named, shown)
+    pictures = list((tmp_path / "records" / "B01" / "1-pictures").glob("*.png"))
+    assert pictures and (tmp_path / "records" / "B01" / "1-cond-alpha.jsonl").is_file()

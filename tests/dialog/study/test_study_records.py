@@ -8,7 +8,9 @@ still shown) and that ``study report`` leaves it out and lists it.
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
+import io
 import json
 import os
 import shutil
@@ -18,6 +20,8 @@ import pytest
 
 from dialog.cli import main
 from dialog.study import questionnaire
+from dialog.study.run import ParticipantRun
+from dialog.study.studyfile import load_study
 
 EXAMPLE = Path(__file__).resolve().parents[3] / "dialog" / "data" / "studies" / "example.toml"
 SESSION = "P01/1-dt-task.jsonl"
@@ -55,17 +59,40 @@ def one_line(text: str) -> str:
 
 
 # -- case 1: a damaged transcript under recorded answers ----------------------------------------------------
-def test_a_transcript_cut_inside_its_last_line_resumes_without_asking_the_questionnaire_again(copy, recorded,
-                                                                                              capsys):
-    answers = (copy / ANSWERS).read_bytes()
-    whole = (copy / SESSION).read_bytes()
-    (copy / SESSION).write_bytes(whole[:-40])  # a crash inside the last turn's line
-    assert study_cli(copy, "run", "--participant", "P01", "--simulated") == 0
+@pytest.mark.parametrize("cut, shown", [("inside the last line", "ends after turn 7 of 8, and line 9 is torn"),
+                                        ("after turn 3, line 5 torn", "ends after turn 3 of 8, and line 5 is torn"),
+                                        ("after turn 3", "ends after turn 3 of 8, but the questionnaire")])
+def test_a_transcript_cut_under_recorded_answers_is_damaged_and_never_continued(copy, capsys, cut, shown):
+    """Issue 42 case 2: the questionnaire is asked only once the last turn is on disk, so a transcript that
+    lost turns beside it was damaged afterwards; continuing it would record new turns under the old ratings."""
+    lines = (copy / SESSION).read_bytes().splitlines(keepends=True)
+    kept = {"inside the last line": b"".join(lines)[:-40], "after turn 3, line 5 torn": b"".join(lines[:4]) +
+            lines[4][:30], "after turn 3": b"".join(lines[:4])}[cut]
+    (copy / SESSION).write_bytes(kept)
+    before = checksums(copy)
+    assert study_cli(copy, "status") == 0
     out = capsys.readouterr().out
-    assert "already recorded (1-dt-task-questionnaire.jsonl); kept as they are" in out
-    assert (copy / ANSWERS).read_bytes() == answers  # the recorded answers, byte for byte
-    assert (copy / SESSION).read_bytes() == whole  # only the torn line was repaired: the same turn again
-    assert not list(copy.rglob("*.superseded-*"))
+    assert "dt-task: running" not in out and "0 running" in out and "1 damaged" in out
+    damaged = [line for line in out.splitlines() if line.startswith("damaged: P01 session 1 (dt-task): ")]
+    assert len(damaged) == 1 and shown in damaged[0], out
+    assert "restore the transcript, or run the condition again with --condition dt-task --again" in damaged[0]
+    for extra in ([], ["--condition", "dt-task"]):
+        assert study_cli(copy, "run", "--participant", "P01", "--simulated", *extra) == 2
+        error = one_line(capsys.readouterr().err)
+        assert "is damaged, so nothing was written" in error and shown in error
+    assert checksums(copy) == before
+
+
+def test_a_torn_transcript_without_answers_yet_resumes_from_its_last_whole_turn(copy, capsys):
+    (copy / ANSWERS).unlink()
+    lines = (copy / SESSION).read_bytes().splitlines(keepends=True)
+    (copy / SESSION).write_bytes(b"".join(lines[:4]) + lines[4][:30])  # a crash while turn 4 was written
+    assert study_cli(copy, "status") == 0
+    assert "dt-task: running 3/8" in capsys.readouterr().out
+    assert study_cli(copy, "run", "--participant", "P01", "--simulated") == 0
+    now = (copy / SESSION).read_bytes().splitlines(keepends=True)
+    assert now[:4] == lines[:4] and len(now) == 9  # the torn line dropped, the whole turns kept, the rest played
+    assert (copy / ANSWERS).is_file()
 
 
 @pytest.mark.parametrize("damage", ["delete", "empty"])
@@ -114,7 +141,8 @@ def _edit_json_line(path: Path, index: int, change) -> None:
 
 
 def _note(folder: Path, **fields) -> None:
-    note = {"study": "example", "participant": "P01", "condition": "dt-task", "order": 1, "software": "x",
+    note = {"study": "example", "participant": "P01", "condition": "dt-task", "order": 1, "software": "teachbot 0.1.0",
+            "simulated": True,
             "reason": "felt unwell", "after_turns": 3} | fields
     (folder / NOTE).write_text(json.dumps({"aborted": note}) + "\n")
 
@@ -123,6 +151,12 @@ def _set(path, index, key, value, table=None):
     def change(record):
         (record[table] if table else record)[key] = value
     return lambda folder: _edit_json_line(folder / path, index, change)
+
+
+def _set_study(path, table, key, value):
+    def change(record):
+        (record[table]["study"] if table == "session" else record[table])[key] = value
+    return lambda folder: _edit_json_line(folder / path, 0, change)
 
 
 def _drop(path, index, key):
@@ -190,6 +224,25 @@ DAMAGES = {
     "questionnaire a FIFO": (lambda f: _fifo(f / ANSWERS), "not a regular file (expected the questionnaire answers"),
     "note a FIFO": (lambda f: _fifo(f / NOTE), "not a regular file (expected the abort note"),
     "transcript nested 100000 deep": (_write_line(SESSION, 2, "[" * 100000 + "\n"), "line 3 nests JSON too deeply"),
+    # issue 42: every field of the header, and every field of a turn, is what study run writes
+    "turn without its answer": (_drop(SESSION, 3, "answer"), "line 4: the turn record has no 'answer' (expected"),
+    "turn without its accuracy": (_drop(SESSION, 5, "accuracy"), "line 6: the turn record has no 'accuracy'"),
+    "header software edited": (_set_study(SESSION, "session", "software", "hacked 9"),
+                               "the header's study software is \"hacked 9\" (expected"),
+    "header software a number": (_set_study(SESSION, "session", "software", 5), "study software is 5"),
+    "header simulated 'yes'": (_set_study(SESSION, "session", "simulated", "yes"), "study simulated is \"yes\""),
+    "header study table extra field": (_set_study(SESSION, "session", "name", "Ann"), "has a field \"name\" that"),
+    "header teacher of a person": (_set(SESSION, 0, "teacher", {"kind": "terminal"}, "session"),
+                                   "the session header's 'teacher' is {\"kind\": \"terminal\"} (expected"),
+    "header costs edited": (_set(SESSION, 0, "costs", {"label": 0, "demo": 0, "feature": 0, "none": 0}, "session"),
+                            "the session header's 'costs' is"),
+    "header fetch_from_pantry edited": (_set(SESSION, 0, "fetch_from_pantry", False, "session"),
+                                        "the session header's 'fetch_from_pantry' is false (expected true"),
+    "header concepts edited": (_set(SESSION, 0, "concepts", ["fruit"], "session"), "the session header's 'concepts'"),
+    "header unknown field": (_set(SESSION, 0, "zz_note", 1, "session"), "has a field \"zz_note\" that study run"),
+    "questionnaire software edited": (_set_study(ANSWERS, "questionnaire", "software", ""), "study software is \"\""),
+    "text answer a lone surrogate": (_set(ANSWERS, 3, "value", "\ud800zz"), "item 'comments' has a value that is "
+                                                                           "not text (character 1 is U+D800"),
 }
 
 
@@ -247,3 +300,57 @@ def test_a_participant_folder_linked_out_of_the_study_folder_is_refused(copy, tm
     assert study_cli(copy, "run", "--participant", "P01", "--simulated", "--condition", "active", "--again") == 2
     assert "would be written outside its folder" in one_line(capsys.readouterr().err)
     assert checksums(outside) == before
+
+
+# -- issue 42 case 1: typed text that is not Unicode text -----------------------------------------------------------
+def _rerun_questionnaire(copy, typed: str):
+    """P01's first session with its questionnaire still due, answered at the terminal by ``typed``."""
+    study = dataclasses.replace(load_study(EXAMPLE), folder=copy)
+    (copy / ANSWERS).unlink()
+    out = io.StringIO()
+    runner = ParticipantRun(study, "P01", False, input_stream=io.StringIO(typed), output_stream=out, viewer=False)
+    return runner.run("dt-task"), out.getvalue()
+
+
+def test_a_lone_surrogate_typed_in_the_questionnaire_is_refused_there_and_nothing_is_lost(copy, capsys):
+    code, out = _rerun_questionnaire(copy, "5\n3\n\ud800zz\nit was fine\n")
+    assert code == 0
+    assert out.count("That text can't be recorded (character 1 is U+D800, half of a surrogate pair") == 1, out
+    assert "Please type any Unicode text" in out and "Answers saved." in out
+    rows = [json.loads(line) for line in (copy / ANSWERS).read_text(encoding="utf-8").splitlines()]
+    assert [row["value"] for row in rows[1:]] == [5, 3, "it was fine"]  # the Likert answers kept, the text asked again
+    assert not list(copy.rglob(".*.tmp"))
+    assert study_cli(copy, "status") == 0
+    assert "P01          dt-task: done" in capsys.readouterr().out
+
+
+def test_the_input_ending_after_a_refused_text_saves_nothing_and_asks_again_later(copy):
+    code, out = _rerun_questionnaire(copy, "5\n3\n\udcffx\n")
+    assert code == 0 and "it is asked again when the run goes on" in out
+    assert not (copy / ANSWERS).exists() and not list(copy.rglob(".*.tmp"))
+
+
+class _Page:
+    """The part of the page's teacher ``ask_web`` uses: each call gives the next form's values."""
+
+    def __init__(self, *forms):
+        self.forms, self.notes = list(forms), []
+
+    def ask_screen(self, title, text, button, items):
+        self.notes.append(text)
+        return self.forms.pop(0)
+
+
+def test_the_page_shows_the_questionnaire_again_with_the_reason_for_text_that_is_not_text():
+    items = load_study(EXAMPLE).items
+    page = _Page([6, None, "\ud83dabc"], [6, None, "abc"])
+    answers = questionnaire.ask_web(items, page)
+    assert [a["value"] for a in answers] == [6, None, "abc"]
+    assert len(page.notes) == 2 and "item 3: character 1 is U+D83D" in page.notes[1]
+
+
+def test_an_answer_that_cannot_be_encoded_leaves_no_file_and_no_temporary_file(tmp_path):
+    path = tmp_path / "P01" / "1-x-questionnaire.jsonl"
+    with pytest.raises(UnicodeEncodeError):
+        questionnaire.save(path, {"study": "example"}, [{"item": "comments", "kind": "text", "value": "\ud800"}])
+    assert not path.exists() and not list(tmp_path.rglob("*.tmp"))

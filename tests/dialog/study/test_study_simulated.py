@@ -175,7 +175,8 @@ def test_a_report_over_simulated_and_real_sessions_refuses_unless_asked(folder, 
     real = copy / "P01" / f"1-{first}.jsonl"
     lines = real.read_text().splitlines()
     header = json.loads(lines[0])
-    header["session"]["study"]["simulated"] = False  # as a participant's own session would record it
+    header["session"]["study"]["simulated"] = False  # as a participant's own session would record it,
+    header["session"]["teacher"] = {"kind": "terminal"}  # with the person at the terminal as its teacher
     real.write_text("\n".join([json.dumps(header)] + lines[1:]) + "\n")
     answers = real.with_name(f"1-{first}-questionnaire.jsonl")
     lines = answers.read_text().splitlines()
@@ -188,3 +189,23 @@ def test_a_report_over_simulated_and_real_sessions_refuses_unless_asked(folder, 
     assert "holds 8 simulated (dry-run) and 1 real sessions" in error and "--allow-mixed" in error
     assert study_cli(copy, "report", "--out", str(tmp_path / "report"), "--allow-mixed") == 0
     assert "**8 of the 9 recorded sessions are simulated" in (tmp_path / "report" / "report.md").read_text()
+
+
+def test_status_and_report_of_the_real_folder_after_a_dry_run_name_the_simulated_folder(tmp_path, monkeypatch,
+                                                                                        capsys):
+    """Issue 42 case 5: after the docs' dry run, ``study report STUDY.toml`` wrote an empty report and said
+    nothing of the simulated sessions in ``<folder>-simulated``."""
+    monkeypatch.chdir(tmp_path)
+    study = tmp_path / "my study.toml"
+    study.write_text(EXAMPLE.read_text().replace("turns = 8", "turns = 2"))
+    assert main(["study", "run", str(study), "--participant", "P01", "--simulated"]) == 0
+    capsys.readouterr()
+    for action in ("report", "status"):
+        command = f"teachbot study {action} '{study}' --simulated"
+        assert main(["study", action, str(study)]) == 0
+        notes = [line for line in capsys.readouterr().out.splitlines() if line.startswith("note: ")]
+        assert notes == [f"note: no session is recorded in runs/studies/example; the simulated sessions (study run "
+                         f"--simulated) are in runs/studies/example-simulated: {command}"]
+    for args in (["--simulated"], ["--folder", "runs/studies/example"]):  # asked for: no note
+        assert main(["study", "report", str(study), *args]) == 0
+        assert "note: " not in capsys.readouterr().out
