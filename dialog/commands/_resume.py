@@ -77,6 +77,9 @@ def continue_command(words: list, args: argparse.Namespace | None = None, option
         value = getattr(args, attribute, None)
         if value is True:
             command.append(option)
+        elif isinstance(value, (list, tuple)):  # a repeatable option (--origin)
+            for item in value:
+                command += [option, str(item)]
         elif value not in (None, False):
             command += [option, f"{value:g}" if isinstance(value, float) else str(value)]
     return shlex.join(command)

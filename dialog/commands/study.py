@@ -83,8 +83,8 @@ def _load(args):
 def _run(args) -> int:
     from dialog.commands._resume import continue_command
     from dialog.study.run import ParticipantRun
-    from dialog.web.session import check_web_options
-    from learning.errors import SettingsError
+    from dialog.web.session import check_web_options, web_continue_options
+    from learning.errors import SettingsError, TeachbotError
 
     check_web_options(args)
     if args.web and (args.simulated or args.abort is not None):
@@ -92,7 +92,7 @@ def _run(args) -> int:
                             f"{'--simulated' if args.simulated else '--abort'}")
     study = _load(args)
     again = continue_command(["teachbot", "study", "run", args.study, "--participant", args.participant], args,
-                             RUN_OPTIONS)
+                             RUN_OPTIONS + web_continue_options(args))
     viewer = False if args.no_viewer else None
     if args.abort is not None or not args.web:
         runner = ParticipantRun(study, args.participant, args.simulated, viewer=viewer,
@@ -105,12 +105,22 @@ def _run(args) -> int:
     if not args.again:
         runner.plan(args.condition, False)  # refuses a participant already done before the page opens
     page = WebPage(args, title=f"Study '{study.name}'")
+    ending = ""  # the runner's "All sessions are done", or why the run stopped
     try:
         runner.page = page
         page.teacher.show_budget = args.show_conditions
-        return runner.run(args.condition, args.again)
+        code = runner.run(args.condition, args.again)
+        if not page.teacher.ended:  # quit, Ctrl-C
+            ending = "The run stopped. What is done is saved; it goes on from there when it is started again."
+        return code
+    except TeachbotError as error:  # a full disk, a damaged record: the page says what stopped the run
+        ending = f"The run stopped: {error}"
+        raise
+    except KeyboardInterrupt:
+        ending = "The run was interrupted. What is done is saved; it goes on from there when it is started again."
+        raise
     finally:
-        page.close()
+        page.close(ending)
 
 
 def _dry_run_note(args, study, action: str) -> str:

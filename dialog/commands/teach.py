@@ -16,7 +16,7 @@ from dialog.commands._arguments import (
     positive_seconds,
     resolve_time,
 )
-from dialog.commands._resume import check_resume_options, continue_command
+from dialog.commands._resume import UNRECORDED_TEACH_OPTIONS, check_resume_options, continue_command
 from dialog.commands._summary import questions_in_words, scene_size, session_time
 from dialog.environment import SimulatedKitchen
 from dialog.episode import embodied_timing
@@ -27,7 +27,7 @@ from dialog.transcripts.jsonl import read_session
 from dialog.transcripts.lock import TranscriptLock
 from dialog.user_weights import add_weights_option, weights_strategy
 from dialog.viewer import add_viewer_option, hold_viewer, start_viewer, stop_viewer
-from dialog.web.session import add_web_options, check_web_options
+from dialog.web.session import add_web_options, check_web_options, web_continue_options
 from learning.errors import OutputPathError, SettingsError, TranscriptError
 from learning.strategies import DEFAULT_STRATEGY, STRATEGY_NAMES
 
@@ -161,6 +161,7 @@ def _teach(args, settings: SessionSettings, path: Path, lock: TranscriptLock, in
     environment = SimulatedKitchen(task=settings.task, kitchen=settings.kitchen, seed=settings.seed,
                                    pictures=pictures is not None, joint_speed=joint_speed)
     viewer = page = None
+    ending = ""  # what the page says at the end: the summary, or why the session stopped
     try:
         if args.web and person:  # the page's server and its 3D view (the meshcat mirror)
             from dialog.web.session import WebPage
@@ -194,26 +195,31 @@ def _teach(args, settings: SessionSettings, path: Path, lock: TranscriptLock, in
         manager.say(intro)
         if person and len(records) < settings.turns and not manager.out_of_time():
             manager.say("Type 'help' at any question for what you can answer; 'quit' saves and stops.")
-        again = continue_command(["teachbot", "teach", "--resume", path], args)
+        again = continue_command(["teachbot", "teach", "--resume", path], args,
+                                 UNRECORDED_TEACH_OPTIONS + web_continue_options(args))
         try:
             result = manager.run(replay=records)
         except KeyboardInterrupt:
-            manager.say(f"\nInterrupted. The session is saved; continue it with: {again}")
+            ending = f"Interrupted. The session is saved; continue it with: {again}"
+            manager.say(f"\n{ending}")
             return 130
         except OutputPathError as error:
-            raise OutputPathError(f"{error}. The completed turns are saved; once that is fixed, continue with: "
-                                  f"{again}") from None
+            ending = (f"{error}. The completed turns are saved; once that is fixed, continue with: {again}")
+            raise OutputPathError(ending) from None
         finally:
             manager.transcript.close()
         if manager.replay_mismatches:
             manager.say(f"(note: on {manager.replay_mismatches} replayed turn(s) the strategy would now ask something "
                         "else; the recorded questions were kept)")
+        saved = f"Session saved after {result.completed} of {result.turns} turns. Continue it with: {again}"
         if result.quit:
-            manager.say(f"Session saved after {result.completed} of {result.turns} turns. Continue it with: {again}")
-        manager.say(f"Accuracy on {settings.task} held-out scenes: {result.accuracy:.1%} (chance "
-                    f"{1 / len(environment.concepts):.0%}); budget spent {result.budget_spent:g} of "
-                    f"{settings.budget:g}; questions: {questions_in_words(result.queries)}; "
-                    f"{session_time(manager.clock, result.seconds, records)}.")
+            manager.say(saved)
+        summary = (f"Accuracy on {settings.task} held-out scenes: {result.accuracy:.1%} (chance "
+                   f"{1 / len(environment.concepts):.0%}); budget spent {result.budget_spent:g} of "
+                   f"{settings.budget:g}; questions: {questions_in_words(result.queries)}; "
+                   f"{session_time(manager.clock, result.seconds, records)}.")
+        manager.say(summary)
+        ending = f"{saved} {summary}" if result.quit else summary
         if args.json:
             print(json.dumps({"seed": result.seed, "strategy": result.strategy, "turns": result.turns,
                               "completed": result.completed, "quit": result.quit, "budget_spent": result.budget_spent,
@@ -223,7 +229,7 @@ def _teach(args, settings: SessionSettings, path: Path, lock: TranscriptLock, in
             hold_viewer(args, viewer, input_stream)
     finally:
         if page is not None:
-            page.close()
+            page.close(ending)
         else:
             stop_viewer(viewer)
         environment.close()

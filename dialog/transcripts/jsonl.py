@@ -51,7 +51,7 @@ class TranscriptWriter:
     def write(self, record: dict) -> None:
         if not self.lock.held:
             raise ValueError(f"{self.path}: the transcript is closed")
-        data = memoryview((json.dumps(record, ensure_ascii=False) + "\n").encode("utf-8"))
+        data = memoryview(encoded_line(record))
         fd = self.lock.fd
         size = os.fstat(fd).st_size
         try:
@@ -78,6 +78,15 @@ class TranscriptWriter:
 
     def __exit__(self, *exc) -> None:
         self.close()
+
+
+def encoded_line(record: dict) -> bytes:
+    """One JSON line in UTF-8. A string with a lone surrogate (no UTF-8 exists for it) is written as its JSON
+    escape (``\\ud800``) instead, so the record is kept, exactly as it was, rather than the turn being lost."""
+    try:
+        return (json.dumps(record, ensure_ascii=False) + "\n").encode("utf-8")
+    except UnicodeEncodeError:
+        return (json.dumps(record, ensure_ascii=True) + "\n").encode("ascii")
 
 
 class MemoryTranscript:

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import json
 import math
+import unicodedata
 from dataclasses import dataclass
 
 from learning.errors import MessageError
@@ -56,6 +57,9 @@ def decode(raw: str | bytes) -> dict:
     except (ValueError, UnicodeDecodeError):
         raise MessageError("a message that is not JSON; accepted: one JSON object such as "
                               '{"type": "concept", "question": 3, "concept": "fruit"}') from None
+    except RecursionError:  # thousands of nested arrays fit in the size limit
+        raise MessageError("a message that nests JSON too deeply; accepted: one flat JSON object such as "
+                           '{"type": "concept", "question": 3, "concept": "fruit"}') from None
     if not isinstance(message, dict):
         raise MessageError(f"a JSON {type(message).__name__}; accepted: one JSON object with a type")
     return message
@@ -67,7 +71,7 @@ def read_message(message: dict, asked: Asked | None, resolve_click=None) -> Page
     ``resolve_click(x, y)`` gives the 0-based object under a click on the camera picture, or None.
     """
     kind = message.get("type")
-    if kind not in KINDS:
+    if not isinstance(kind, str) or kind not in KINDS:
         raise MessageError(f"message type {_shown(kind)}; accepted: {', '.join(KINDS)}")
     unknown = sorted(set(message) - set(COMMON) - set(KINDS[kind]))
     if unknown:
@@ -75,7 +79,7 @@ def read_message(message: dict, asked: Asked | None, resolve_click=None) -> Page
                               f"{', '.join(COMMON + KINDS[kind])}")
     if asked is None:
         raise MessageError("an answer while no question is open; accepted: answers to the question shown")
-    if message.get("question") != asked.question or isinstance(message.get("question"), bool):
+    if not _is_whole(message.get("question")) or message.get("question") != asked.question:
         raise MessageError(f"an answer to question {_shown(message.get('question'))}; accepted: answers to the "
                               f"open question {asked.question}")
     page_ms = message.get("page_ms")
@@ -89,9 +93,9 @@ def read_message(message: dict, asked: Asked | None, resolve_click=None) -> Page
 def _line(kind: str, message: dict, asked: Asked, resolve_click) -> tuple[str, str]:
     if kind == "typed":
         text = message.get("text")
-        if not isinstance(text, str) or len(text) > MAX_TYPED_CHARS or "\n" in text or "\r" in text:
-            raise MessageError(f"typed text {_shown(text)}; accepted: one line of at most {MAX_TYPED_CHARS} "
-                                  "characters")
+        if not isinstance(text, str) or len(text) > MAX_TYPED_CHARS or _text_problem(text):
+            raise MessageError(f"typed text {_shown(text)}{_text_problem(text)}; accepted: one line of at most "
+                               f"{MAX_TYPED_CHARS} characters, without control characters")
         return text, "typed"
     if kind == "command":
         command = message.get("command")
@@ -138,19 +142,39 @@ def _line(kind: str, message: dict, asked: Asked, resolve_click) -> tuple[str, s
 
 
 def _is_number(value) -> bool:
-    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+    """A JSON number that is finite (a whole number of any length is: math.isfinite would overflow on it)."""
+    return _is_whole(value) or (isinstance(value, float) and math.isfinite(value))
 
 
 def _is_whole(value) -> bool:
     return isinstance(value, int) and not isinstance(value, bool)
 
 
+def _text_problem(text, allowed: str = "") -> str:
+    """Why a text from the page cannot be taken ("": it can): a lone surrogate (it has no UTF-8, so neither the
+    transcript nor the page could hold it) or a control character other than ``allowed``."""
+    if not isinstance(text, str):
+        return ""
+    for ch in text:
+        category = unicodedata.category(ch)
+        if category == "Cs":
+            return f" (it holds a lone surrogate, U+{ord(ch):04X}, which is no character)"
+        if category == "Cc" and ch not in allowed:
+            return f" (it holds a control character, U+{ord(ch):04X})"
+    return ""
+
+
 def _shown(value) -> str:
-    text = json.dumps(value, ensure_ascii=False, default=str)
+    """``value`` as it came, in JSON, cut to 60 characters (nested too deeply to show: its type)."""
+    try:
+        text = json.dumps(value, ensure_ascii=False, default=str).encode("utf-8", "backslashreplace").decode("utf-8")
+    except RecursionError:
+        return f"(a JSON {type(value).__name__} nested too deeply to show)"
     return text if len(text) <= 60 else f"{text[:60]}... ({len(text)} characters)"
 
 
 MAX_FREE_TEXT = 2000  # as at the terminal (dialog/study/questionnaire.py)
+FREE_TEXT_CONTROLS = "\t\n\r"  # the control characters a text box may hold
 
 
 def read_screen(message: dict, screen: dict | None) -> list:
@@ -159,7 +183,7 @@ def read_screen(message: dict, screen: dict | None) -> list:
     if unknown:
         raise MessageError(f"unknown fields {', '.join(map(_shown, unknown))} in a screen message; accepted: type, "
                            "screen, answers")
-    if screen is None or message.get("screen") != screen["id"] or isinstance(message.get("screen"), bool):
+    if screen is None or not _is_whole(message.get("screen")) or message.get("screen") != screen["id"]:
         raise MessageError(f"an answer to screen {_shown(message.get('screen'))}; accepted: answers to the screen "
                            "shown")
     items, answers = screen.get("items", []), message.get("answers")
@@ -168,15 +192,19 @@ def read_screen(message: dict, screen: dict | None) -> list:
     values = []
     for number, (item, answer) in enumerate(zip(items, answers), start=1):
         if item["kind"] == "likert":
+            points = [str(point) for point in range(item["low"], item["high"] + 1)]
             if answer == "":
                 values.append(None)
-            elif answer.isdigit() and item["low"] <= int(answer) <= item["high"]:
+            elif answer in points:  # not str.isdigit: "²" is a digit that int() refuses
                 values.append(int(answer))
             else:
                 raise MessageError(f"item {number}: {_shown(answer)}; accepted: a whole number from {item['low']} "
                                    f"to {item['high']}, or none")
         elif len(answer) > MAX_FREE_TEXT:
             raise MessageError(f"item {number}: a text of {len(answer)} characters; accepted: at most {MAX_FREE_TEXT}")
+        elif _text_problem(answer, FREE_TEXT_CONTROLS):
+            raise MessageError(f"item {number}: a text{_text_problem(answer, FREE_TEXT_CONTROLS)}; accepted: plain "
+                               "text (line breaks and tabs are fine)")
         else:
             values.append(answer.strip() or None)
     return values

@@ -87,6 +87,10 @@ class _Checked:
     def initialize(self, server: WebServer) -> None:
         self.server = server
 
+    def set_default_headers(self) -> None:  # every response, refusals and errors too
+        for name, value in SECURITY_HEADERS.items():
+            self.set_header(name, value)
+
     def refuse_unless_allowed(self) -> None:
         request = self.request
         if request.host not in self.server.hosts:
@@ -102,13 +106,16 @@ class _Handler(_Checked, tornado.web.RequestHandler):
     def prepare(self) -> None:
         self.refuse_unless_allowed()
 
-    def set_default_headers(self) -> None:
-        for name, value in SECURITY_HEADERS.items():
-            self.set_header(name, value)
-
     def write_error(self, status_code: int, **kwargs) -> None:
         self.set_header("Content-Type", "text/plain; charset=utf-8")
         self.finish(f"{status_code} {self._reason}: open the page with the URL teachbot printed.\n")
+
+
+class NotFoundHandler(_Handler):
+    """Any path outside the routes: 404, with the security headers as every response."""
+
+    def prepare(self) -> None:
+        raise tornado.web.HTTPError(404, reason="Not found")
 
 
 class PageHandler(_Handler):
@@ -147,15 +154,16 @@ class PictureHandler(_Handler):
 class _Socket(_Checked, tornado.websocket.WebSocketHandler):
     def prepare(self) -> None:
         self.refuse_unless_allowed()
-        if "Origin" not in self.request.headers:  # every browser sends it; a page of this server has this one
+        origin = self.request.headers.get("Origin")
+        if origin is None:  # every browser sends it; a page of this server has this one
             self.server.log_refusal("a websocket without an Origin")
             raise tornado.web.HTTPError(403, reason="No origin")
+        if origin not in self.server.origins:  # checked here: tornado skips check_origin when the host matches
+            self.server.log_refusal(f"a websocket from the foreign origin {origin!r}")
+            raise tornado.web.HTTPError(403, reason="Foreign origin")
 
     def check_origin(self, origin: str) -> bool:
-        if origin in self.server.origins:
-            return True
-        self.server.log_refusal(f"a websocket from the foreign origin {origin!r}")
-        return False
+        return origin in self.server.origins  # prepare refused every other origin already
 
 
 class SessionSocket(_Socket):
@@ -253,6 +261,7 @@ class WebServer:
                     (r"/picture/([0-9]{1,9})", PictureHandler), (r"/ws", SessionSocket),
                     (r"/meshcat-ws", MeshcatSocket)]
         return tornado.web.Application([(path, handler, {"server": self}) for path, handler in handlers],
+                                       default_handler_class=NotFoundHandler, default_handler_args={"server": self},
                                        websocket_max_message_size=WEBSOCKET_LIMIT_BYTES,
                                        log_function=lambda handler: None)
 
@@ -281,7 +290,7 @@ class WebServer:
         """Send ``message`` to every open page (from any thread)."""
         if self._loop is None:
             return
-        text = json.dumps(message, ensure_ascii=False)
+        text = json.dumps(message)  # ASCII: whatever a line holds, it reaches the page (a lone surrogate has no UTF-8)
 
         def send() -> None:
             for socket in list(self.sockets):

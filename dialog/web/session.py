@@ -10,8 +10,11 @@ Wiring, in a command module::
 from __future__ import annotations
 
 import argparse
+import shutil
 import sys
+import tempfile
 import time
+from pathlib import Path
 
 from dialog.commands._arguments import number_within
 from dialog.web.server import LOOPBACK, WebServer, check_host, is_loopback, meshcat_socket, public_origin
@@ -52,25 +55,44 @@ def check_web_options(args: argparse.Namespace) -> None:
         public_origin(origin)
 
 
+def web_continue_options(args: argparse.Namespace) -> tuple:
+    """The page's options a "continue with" line repeats, as (option, attribute): with --web, the command that
+    goes on must open the page again (the address only where it is not the default)."""
+    if not getattr(args, "web", False):
+        return ()
+    return tuple((option, name) for option, name in (("--web", "web"), ("--host", "host"), ("--port", "port"),
+                                                     ("--allow-remote", "allow_remote"), ("--origin", "origin"),
+                                                     ("--no-3d", "no_3d"))
+                 if name != "host" or args.host != LOOPBACK)
+
+
 WAIT_FOR_PAGE_S = 60.0
 MIRROR_WAIT_S = 2.0  # the longest a question waits for the 3D view's mirror (a stuck meshcat server stops it)
 
 
 class Watcher:
-    """A dialog observer that shows a scripted episode in the page as it happens (``demo --web``)."""
+    """A dialog observer that shows a scripted episode in the page as it happens (``demo --web``): each question
+    with the numbered camera picture of its scene, drawn once a scene (while the arm rests out of the camera's
+    view, before the turn's pace is waited) into ``pictures`` (a folder).
 
-    def __init__(self, teacher):
-        self.teacher = teacher
+    Its lines go to the page only: the terminal prints the episode's own lines already."""
+
+    def __init__(self, teacher, environment=None, pictures: Path | None = None):
+        self.teacher, self.environment, self.pictures = teacher, environment, pictures
         self.turn = 0
+        self.picture: str | None = None
 
     def on_scene(self, scene=None) -> None:
+        if hasattr(self.environment, "scene_picture") and scene is not None and self.pictures is not None:
+            path = self.pictures / f"scene-from-turn-{self.turn + 1:03d}.png"
+            self.picture = str(self.environment.scene_picture(scene, path))
         self.teacher.say(f"-- turn {self.turn + 1}: the robot looks at a new scene of "
-                         f"{getattr(scene, 'n_objects', '?')} objects")
+                         f"{getattr(scene, 'n_objects', '?')} objects", echo=False)
 
     def on_question(self, action, text=None, scene=None) -> None:
         index = getattr(action, "object_index", None)
         self.teacher.watch(self.turn + 1, str(getattr(action, "kind", "")), text or "",
-                           None if index is None else int(index) + 1)
+                           None if index is None else int(index) + 1, self.picture)
 
     def on_answer(self, action, outcome=None, scene=None) -> None:
         self.teacher.heard(getattr(outcome, "raw", "") or f"({getattr(outcome, 'kind', 'no answer')})")
@@ -78,7 +100,7 @@ class Watcher:
     def on_turn(self, record=None, scene=None) -> None:
         self.turn += 1
         if isinstance(record, dict) and record.get("action", {}).get("kind") == "none":
-            self.teacher.say(f"Turn {self.turn}: the robot stays quiet.")
+            self.teacher.say(f"Turn {self.turn}: the robot stays quiet.", echo=False)
 
 
 class WebPage:
@@ -90,6 +112,8 @@ class WebPage:
         self.args, self.three_d = args, three_d and not getattr(args, "no_3d", False)
         self.teacher = WebTeacher(echo=self.out)
         self.viewer = None
+        self.environment = None
+        self._pictures: Path | None = None  # a watched demo's camera pictures (a temporary folder)
         self.server = WebServer(self.teacher, host=args.host, port=args.port, allow_remote=args.allow_remote,
                                 origins=tuple(args.origin), title=title)
         if args.allow_remote and not is_loopback(args.host):
@@ -112,6 +136,7 @@ class WebPage:
     def attach(self, environment) -> None:
         """Show ``environment``'s kitchen: clicks on its camera picture, its 3D view (when meshcat starts)."""
         self.detach()
+        self.environment = environment
         self.teacher.locate = getattr(environment, "picture_pixels", None)
         if self.three_d and getattr(environment, "world", None) is not None:
             from dialog.viewer import start_viewer
@@ -163,10 +188,16 @@ class WebPage:
         return True
 
     def watcher(self) -> Watcher:
-        return Watcher(self.teacher)
+        if self._pictures is None:
+            self._pictures = Path(tempfile.mkdtemp(prefix="teachbot-demo-pictures-"))
+        return Watcher(self.teacher, self.environment, self._pictures)
 
     def close(self, text: str = "") -> None:
-        """The session is over: the page says so, then the server and the 3D view stop."""
+        """The session is over: the page says so (``text``: the summary, or why it stopped; without it, what it
+        said already), then the server and the 3D view stop."""
         self.teacher.end(text)
         self.server.close()
         self.detach()
+        if self._pictures is not None:
+            shutil.rmtree(self._pictures, ignore_errors=True)
+            self._pictures = None

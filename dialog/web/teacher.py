@@ -46,6 +46,7 @@ class WebTeacher:
         self.current: dict | None = None
         self.pictures: dict[int, str] = {}
         self.ended = False
+        self.end_text = ""  # what the page says once the session is over (the summary, or why it stopped)
         self.refused = 0
         self.nodes: dict[str, int] = {}
         self.view = 0  # which 3D view the page shows (a study's next session brings a new one)
@@ -63,7 +64,7 @@ class WebTeacher:
         with self._lock:
             return {"type": "state", "conversation": list(self.conversation), "question": self.current,
                     "waiting": self._waiting, "ended": self.ended, "nodes": dict(self.nodes),
-                    "screen": self._screen, "view": self.view if self.has_view else 0}
+                    "screen": self._screen, "view": self.view if self.has_view else 0, "end_text": self.end_text}
 
     def _post(self, message: dict) -> None:
         self.broadcast(message)
@@ -127,21 +128,23 @@ class WebTeacher:
             with self._lock:
                 self._waiting = False
 
-    def watch(self, turn: int, kind: str, text: str, number: int | None) -> None:
-        """A scripted episode's question, shown without answer controls (``demo --web``)."""
+    def watch(self, turn: int, kind: str, text: str, number: int | None, picture: str | None = None) -> None:
+        """A scripted episode's question with its camera picture, shown without answer controls (``demo --web``)."""
         with self._lock:
             self._question += 1
+            if picture:
+                self.pictures[self._question] = picture
             self.current = {"id": self._question, "turn": turn, "turns": None, "budget_left": None,
                             "expects": kind, "text": text, "object": number, "watch": True, "concepts": [],
-                            "objects": 0, "picture": False, "details": [], "features": [], "seconds_left": None,
-                            "help": ""}
+                            "objects": 0, "picture": bool(picture), "details": [], "features": [],
+                            "seconds_left": None, "help": ""}
             question = dict(self.current)
         self._note("robot", text)
         self._post({"type": "question", "question": question})
 
     def heard(self, text: str) -> None:
-        """A scripted teacher's answer, shown as the teacher's line."""
-        self._note("teacher", text)
+        """A scripted teacher's answer, shown as the teacher's line ("Teacher: ", not the person's "You: ")."""
+        self._note("scripted", text)
 
     def answer_channel(self) -> dict:
         last = self._last
@@ -150,9 +153,10 @@ class WebTeacher:
     def tell(self, text: str) -> None:
         self._note("robot", text)
 
-    def say(self, text: str) -> None:
-        """A line from the session itself (progress, the summary); printed at the terminal too."""
-        if self.echo is not None:
+    def say(self, text: str, echo: bool = True) -> None:
+        """A line from the session itself (progress, the summary); printed at the terminal too unless not ``echo``
+        (a line the terminal gets from elsewhere)."""
+        if echo and self.echo is not None:
             print(text, file=self.echo, flush=True)
         self._note("session", text.strip())
 
@@ -171,9 +175,14 @@ class WebTeacher:
         self._post({"type": "nodes", "nodes": dict(nodes)})
 
     def end(self, text: str = "") -> None:
-        """The session is over: the page says so and takes no more answers."""
+        """The session is over: the page says so (``text``: the summary, or why it stopped) and takes no more
+        answers. A later call without text keeps what the page says."""
         with self._lock:
+            if self.ended and not text:
+                return
             self.ended, self.current, self._asked = True, None, None
+            self.end_text = text or self.end_text
+            text = self.end_text
         self._post({"type": "ended", "text": text})
 
     def ask_screen(self, title: str, text: str = "", button: str = "Continue", items: list | None = None) -> list:

@@ -20,6 +20,21 @@ def test_header_then_turns(tmp_path):
     assert records == [{"turn": 1, "answer": {"raw": "\u00e9t\u00e9"}}] == read_transcript(path)
 
 
+
+def test_a_lone_surrogate_in_a_record_is_kept_and_the_turn_is_not_lost(tmp_path):
+    """Issue 42, case 1: a string UTF-8 cannot hold raised UnicodeEncodeError here and the session lost its turn.
+    Its record is written with the JSON escape instead; every other record stays byte-identical (UTF-8)."""
+    path = tmp_path / "t.jsonl"
+    with TranscriptWriter(path) as writer:
+        writer.write({"turn": 1, "answer": {"raw": "\u00e9t\u00e9"}})
+        writer.write({"turn": 2, "answer": {"lines": ["\ud800zz", "fruit"], "raw": "fruit"}})
+        writer.write({"turn": 3, "answer": {"raw": "\u00e9"}})
+    lines = path.read_bytes().splitlines()
+    assert lines[0] == '{"turn": 1, "answer": {"raw": "\u00e9t\u00e9"}}'.encode("utf-8")
+    assert b"\\ud800zz" in lines[1] and lines[1].isascii()
+    assert [r["turn"] for r in read_transcript(path)] == [1, 2, 3]
+    assert read_transcript(path)[1]["answer"]["lines"] == ["\ud800zz", "fruit"]
+
 def test_a_line_cut_short_by_a_crash_is_dropped_on_append(tmp_path):
     path = tmp_path / "t.jsonl"
     path.write_text('{"turn": 1}\n{"turn": 2}\n{"turn": 3, "answ')

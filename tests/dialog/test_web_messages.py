@@ -4,7 +4,7 @@ import json
 
 import pytest
 
-from dialog.web.messages import MAX_MESSAGE_BYTES, Asked, decode, read_message
+from dialog.web.messages import MAX_MESSAGE_BYTES, Asked, decode, read_message, read_screen
 from learning.errors import MessageError, TeachbotError
 
 CONCEPTS = ("main dish", "snack", "fruit", "beverage")
@@ -76,3 +76,62 @@ def test_what_is_not_one_small_json_object_is_refused(raw, says):
     with pytest.raises(MessageError, match=says):
         decode(raw)
     assert decode(json.dumps({"type": "typed"})) == {"type": "typed"}
+
+
+DEEP = "[" * 1500 + "]" * 1500
+
+
+@pytest.mark.parametrize("message, asked, says", [
+    ({"type": "typed", "text": "\ud800zz", "question": 4}, LABEL, "lone surrogate, U+D800"),
+    ({"type": "typed", "text": "fr\x00uit", "question": 4}, LABEL, "control character, U+0000"),
+    ({"type": "typed", "text": "fruit\x1b[2J", "question": 4}, LABEL, "control character, U+001B"),
+    ({"type": "typed", "text": "fruit\x85", "question": 4}, LABEL, "control character, U+0085"),
+    ({"type": "typed", "text": "a\tb", "question": 4}, LABEL, "control character, U+0009"),
+    ({"type": ["concept"], "concept": "fruit", "question": 4}, LABEL, "message type [\"concept\"]"),
+    ({"type": {}, "concept": "fruit", "question": 4}, LABEL, "message type {}"),
+    ({"type": "concept", "concept": "fruit", "question": 4, "page_ms": int("9" * 401)}, LABEL, "page_ms 999"),
+    ({"type": "click", "x": int("9" * 401), "y": 0.5, "question": 5}, DEMO, "x and y from 0 to 1"),
+    ({"type": "click", "x": 0.5, "y": -int("9" * 401), "question": 5}, DEMO, "x and y from 0 to 1"),
+    ({"type": "concept", "concept": "fruit", "question": 4.0}, LABEL, "question 4.0"),
+    ({"type": "concept", "concept": "fruit", "question": "4"}, LABEL, "question \"4\""),
+    ({"type": "typed", "text": json.loads("[" * 900 + "]" * 900), "question": 4}, LABEL, "typed text [[[["),
+])
+def test_text_that_cannot_be_kept_and_odd_json_values_are_refused_in_one_line(message, asked, says):
+    """Issue 42, cases 1 and 2: each of these raised TypeError, OverflowError or RecursionError, or was taken."""
+    with pytest.raises(MessageError) as refused:
+        read_message(message, asked, lambda x, y: 0)
+    assert says in str(refused.value) and "\n" not in str(refused.value)
+    str(refused.value).encode("utf-8")  # the refusal itself can be sent and logged
+
+
+def test_a_page_ms_of_any_length_and_a_whole_click_are_numbers():
+    assert read_message({"type": "concept", "concept": "fruit", "question": 4, "page_ms": 0}, LABEL).page_seconds == 0
+    assert read_message({"type": "click", "x": 1, "y": 0, "question": 5}, DEMO, lambda x, y: 2).line == "number 3"
+
+
+@pytest.mark.parametrize("raw", [DEEP, '{"type": "typed", "question": 4, "text": ' + DEEP + "}"])
+def test_deeply_nested_json_is_refused_not_a_recursion_error(raw):
+    assert len(raw.encode()) <= MAX_MESSAGE_BYTES
+    with pytest.raises(MessageError, match="nests JSON too deeply"):
+        decode(raw)
+
+
+SCREEN = {"id": 7, "items": [{"kind": "likert", "low": 1, "high": 5}, {"kind": "text"}]}
+
+
+@pytest.mark.parametrize("answers, screen_id, says", [
+    (["3", "fine\ud800"], 7, "item 2: a text (it holds a lone surrogate"),
+    (["3", "fine\x07"], 7, "item 2: a text (it holds a control character, U+0007)"),
+    (["\u00b2", ""], 7, "item 1"),  # a digit int() refuses
+    (["\u0663", ""], 7, "item 1"),  # an Arabic-Indic 3 is not a point of the scale's radio buttons
+    (["3", ""], 7.0, "screen 7.0"),
+])
+def test_a_study_screen_refuses_unkeepable_text_odd_digits_and_float_ids(answers, screen_id, says):
+    with pytest.raises(MessageError) as refused:
+        read_screen({"type": "screen", "screen": screen_id, "answers": answers}, SCREEN)
+    assert says in str(refused.value)
+
+
+def test_a_study_screen_keeps_line_breaks_and_tabs_in_free_text():
+    assert read_screen({"type": "screen", "screen": 7, "answers": ["5", "two\nlines\tand a tab"]}, SCREEN) == \
+        [5, "two\nlines\tand a tab"]

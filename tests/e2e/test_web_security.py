@@ -149,3 +149,84 @@ async def refusal(socket) -> str:
         message = json.loads(text)
         if message.get("type") == "refused":
             return message["reason"]
+
+
+def test_hostile_values_each_get_one_refusal_and_no_turn_is_lost(tmp_path):
+    """Issue 42, cases 1 and 2 at a real session: a lone surrogate, control characters, a type that is a list or
+    an object, a 401-digit page_ms or click, 1,500 nested arrays (alone and inside ``text``) and the question id
+    1.0 each get one refusal, print no traceback and leave the socket open; every turn after them is recorded."""
+    command = WebCommand("teach", "--web", "--seed", "0", "--turns", "3", "--transcript", "runs/t.jsonl",
+                         cwd=tmp_path)
+    path = tmp_path / "runs/t.jsonl"
+    try:
+        base, token = command.url.split("?token=")
+        socket_url = f"{base.replace('http://', 'ws://')}ws?token={token}"
+
+        async def scenario():
+            socket = await connect(socket_url, base.rstrip("/"))
+            deep = "[" * 1500 + "]" * 1500
+            for _ in range(3):
+                question = await open_question(socket)
+                ident, concept = question["id"], question["concepts"][0]
+                hostile = [json.dumps({"type": "typed", "question": ident, "text": "\ud800zz"}),
+                           json.dumps({"type": "typed", "question": ident, "text": "fruit\x1b[2J\x00"}),
+                           json.dumps({"type": ["concept"], "question": ident, "concept": concept}),
+                           json.dumps({"type": {}, "question": ident, "concept": concept}),
+                           json.dumps({"type": "concept", "question": ident, "concept": concept,
+                                       "page_ms": int("9" * 401)}),
+                           deep, f'{{"type": "typed", "question": {ident}, "text": {deep}}}',
+                           json.dumps({"type": "concept", "question": float(ident), "concept": concept})]
+                for message in hostile:
+                    socket.write_message(message)
+                    assert await refusal(socket)
+                socket.write_message(json.dumps({"type": "concept", "question": ident, "concept": concept}))
+            socket.close()
+
+        asyncio.run(asyncio.wait_for(scenario(), 240))
+        assert command.finish(90) == 0
+    finally:
+        command.stop()
+    err = "".join(command.err)
+    assert "Traceback" not in err and "Error" not in err.replace("MessageError", ""), err[-3000:]
+    assert sum("web: refused a message" in line for line in command.err) == 3 * 8
+    records = read_session(path)[1]
+    assert [r["turn"] for r in records] == [1, 2, 3]
+    assert all(r["answer"]["lines"] == [r["answer"]["raw"]] for r in records)  # nothing hostile was taken
+
+
+def test_only_the_exact_origin_is_accepted_and_every_response_has_the_security_headers():
+    """Issue 42, case 5: tornado accepts an Origin whose host and port match whatever its scheme or path; and a
+    path outside the routes got tornado's own 404 without the security headers."""
+    import io
+    import urllib.error
+    import urllib.request
+
+    from dialog.web.server import SECURITY_HEADERS, WebServer
+    from dialog.web.teacher import WebTeacher
+
+    log = io.StringIO()
+    server = WebServer(WebTeacher(log=log), log=log)
+    try:
+        where = f"127.0.0.1:{server.port}"
+        socket_url = f"ws://{where}/ws?token={server.token}"
+
+        async def origins():
+            codes = {}
+            for origin in (f"http://{where}", f"http://localhost:{server.port}", f"https://{where}",
+                           f"http://{where}/other/path", f"ws://{where}", f"http://{where}/", "null"):
+                codes[origin] = await refused(socket_url, origin)
+            return codes
+
+        codes = asyncio.run(origins())
+        assert [code for code in codes.values()] == [101, 101, 403, 403, 403, 403, 403], codes
+        for path in ("/nope", f"/nope?token={server.token}", f"/static/x.js?token={server.token}", "/ws",
+                     f"/picture/1?token={server.token}", f"/?token={server.token}"):
+            try:
+                response = urllib.request.urlopen(f"http://{where}{path}", timeout=10)
+                status, headers = response.status, response.headers
+            except urllib.error.HTTPError as error:
+                status, headers = error.code, error.headers
+            assert status in (200, 403, 404), (path, status)
+            assert all(headers.get(name) == value for name, value in SECURITY_HEADERS.items()), (path, status)
+    finally:
+        server.close()

@@ -43,7 +43,7 @@ function handle(message) {
     if (message.screen) { showScreen(message.screen); }
     if (message.view !== view) { start3d(message.view); }
     setWaiting(message.waiting);
-    if (message.ended) { showEnded(""); }
+    if (message.ended) { showEnded(message.end_text); }
     objectNodes = message.nodes || {};
   } else if (message.type === "line") {
     addLine(message);
@@ -68,7 +68,8 @@ function handle(message) {
 function addLine(entry) {
   const item = document.createElement("li");
   item.className = entry.who;
-  item.textContent = (entry.who === "robot" ? "Robot: " : entry.who === "teacher" ? "You: " : "") + entry.text;
+  const who = {robot: "Robot: ", teacher: "You: ", scripted: "Teacher: "};  // scripted: demo's teacher
+  item.textContent = (who[entry.who] || "") + entry.text;
   $("conversation").appendChild(item);
   item.scrollIntoView({block: "nearest"});
 }
