@@ -36,6 +36,8 @@ from learning.answers import DemoRow
 from learning.evaluation import accuracy
 from learning.state import LearningState
 from learning.strategies import Strategy
+from learning.strategies.check import refuse_invalid_decision
+from learning.strategies.plugins import is_plugin
 from learning.turn import admissible, scene_epoch
 
 __all__ = ["DialogManager", "EpisodeConfig", "EpisodeResult", "episode_generators", "question_text"]
@@ -208,6 +210,8 @@ class DialogManager:
             action, explanation = decision.action, decision.explanation
         chosen = action
         action, reason = admissible(self.state, chosen)  # learning.turn: the library's rules
+        if action != chosen and is_plugin(self.strategy):  # the user's code is held to the contract, not mended
+            raise refuse_invalid_decision(self.strategy.name, chosen, reason, self.turn + 1)
         return self.realise(action, reason or explanation, start, chosen)
 
     def realise(self, action: Action, explanation: str, start: float, chosen: Action | None = None) -> dict | None:

@@ -3,12 +3,12 @@
 from __future__ import annotations
 
 import argparse
-import json
 from dataclasses import asdict
 from pathlib import Path
 
 from dialog.commands._arguments import add_episode_options, add_time_options, resolve_time
 from dialog.commands._arguments import seconds as seconds_type
+from dialog.commands._json import print_json
 from dialog.commands._summary import questions_in_words, scene_size
 from dialog.environment import SimulatedKitchen
 from dialog.episode import build_episode, embodied_timing
@@ -130,5 +130,5 @@ def _print_summary(args: argparse.Namespace, result, environment, manager) -> No
     if args.json:
         summary = {key: asdict(result)[key] for key in SUMMARY_KEYS}
         summary["queries"] = {kind: summary["queries"][kind] for kind in ("label", "demo", "feature", "none")}
-        print(json.dumps(summary), flush=True)
+        print_json(summary)
     return line

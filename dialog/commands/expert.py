@@ -3,11 +3,11 @@
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 from pathlib import Path
 
 from dialog.commands._arguments import add_kitchen_option, add_task_option, budget, positive_int, seed
+from dialog.commands._json import print_json
 from dialog.commands._summary import questions_in_words
 from dialog.expert.episode import ExpertSettings
 from learning.actions import DEFAULT_COSTS
@@ -95,8 +95,8 @@ def run(args: argparse.Namespace, input_stream=None, output_stream=None) -> int:
           f"transcript: {outcome.transcript}",
           file=out, flush=True)
     if args.json:
-        print(json.dumps({"seed": settings.seed, "expert": chooser.name, "turns": len(outcome.episode.turns),
+        print_json({"seed": settings.seed, "expert": chooser.name, "turns": len(outcome.episode.turns),
                           "quit": result.quit, "budget_spent": result.budget_spent, "queries": result.queries,
                           "accuracy": round(result.accuracy, 6), "demonstration": str(outcome.demonstration),
-                          "transcript": str(outcome.transcript)}), file=out, flush=True)
+                          "transcript": str(outcome.transcript)}, file=out)
     return 0

@@ -12,11 +12,11 @@ learning.irl.maxent, kept by agreement with held-out demonstrations.
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 import time
 
 from dialog.commands._arguments import positive_int, seed
+from dialog.commands._json import print_json, strict_json
 from dialog.experiments.provenance import git_commit
 from dialog.output_paths import check_writable, file_argument, make_parent, writing
 from dialog.user_weights import UserWeights
@@ -32,9 +32,10 @@ def register(commands) -> None:
     parser = commands.add_parser(
         "learn-weights", help="learn the DT-task-env decision-feature weights from expert demonstrations (IRL)",
         description="Fit maximum-entropy IRL (thesis eq. 7.5-7.7) to expert questioning episodes and write a "
-                    "weights file the DT strategies read. By default the trajectory-level fit of eq. 7.7: the "
-                    "learner's feature counts come from rollouts of the dialog loop in the training condition, "
-                    "and the iterate whose greedy episodes end most accurate on validation seeds is kept.")
+                    "weights file the DT strategies read. By default (--method imitation) per-turn MaxEnt fits "
+                    "over splits of the demonstrations and random starts, judged by how well they imitate held-out "
+                    "demonstrations; --method trajectory is the thesis's trajectory-level fit of eq. 7.7 (the "
+                    "learner's feature counts from rollouts of the dialog loop), --method per-turn one per-turn fit.")
     parser.add_argument("--demos", required=True, metavar="DIR_OR_shipped",
                         help="a directory of .json/.npz demonstrations (teachbot expert --out), one such file, or "
                              "'shipped' (learning/irl/expert-demos)")
@@ -130,11 +131,11 @@ def run(args: argparse.Namespace, output_stream=None) -> int:
     if getattr(args, "report", None) is not None:
         make_parent(args.report, "fit report")
         with writing(args.report, "fit report"):
-            args.report.write_text(json.dumps(learned.summary(), indent=1) + "\n", encoding="utf-8")
+            args.report.write_text(strict_json(learned.summary(), indent=1) + "\n", encoding="utf-8")
         print(f"wrote {args.report}", file=out)
     fitted.warn_if_never_asks()
     if args.json:
-        print(json.dumps(learned.summary()), file=out, flush=True)
+        print_json(learned.summary(), file=out)
     return 0
 
 

@@ -16,13 +16,13 @@ writes the run as one HTML page); ``--json`` ends the output with one JSON line.
 from __future__ import annotations
 
 import argparse
-import json
 import time
 
 import numpy as np
 
 from bullet_world.recipes.setup import load_recipe_setup
 from dialog.commands._arguments import add_kitchen_option, add_task_option, positive_int, seed
+from dialog.commands._json import print_json
 from dialog.recipe_session import (
     NarratedRecipeWorld,
     StepOutcome,
@@ -100,7 +100,7 @@ def run(args: argparse.Namespace) -> int:
             summary = _session(args, recipe, world, rng, world.narrate)
             summary["seconds"] = round(time.perf_counter() - started, 1)
             if args.json:
-                print(json.dumps(summary), flush=True)
+                print_json(summary)
             hold_viewer(args, viewer)
         finally:
             stop_viewer(viewer)

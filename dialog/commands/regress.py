@@ -7,13 +7,13 @@ does the work: load, run, report, check.
 from __future__ import annotations
 
 import argparse
-import json
 import shlex
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
 from dialog.commands._arguments import budget, data_seed, positive_int, seeds
+from dialog.commands._json import print_json
 from dialog.experiments.baseline import (
     baseline_path,
     refuse_baseline_from_another_run,
@@ -150,8 +150,8 @@ def run(args: argparse.Namespace) -> int:
         data = {} if suite.kind == "recipes" else {"data_seed": suite.data_seed}  # recipes render no data sets
         use = {} if sweep is None else {"episodes_per_second": round(sweep.runs_per_second, 3),
                                         "cpu_use": round(sweep.cpu_use, 3)}
-        print(json.dumps({"suite": suite.name, "episodes": outcome.count, "seconds": round(outcome.seconds, 2),
-                          **data, **use, "passed": not failures, "failures": failures}))
+        print_json({"suite": suite.name, "episodes": outcome.count, "seconds": round(outcome.seconds, 2),
+                          **data, **use, "passed": not failures, "failures": failures})
     return 1 if failures else 0
 
 
@@ -206,7 +206,7 @@ def run_on_data_seeds(args: argparse.Namespace, kind, suite, original, out: Path
     for outcome in pooled:
         print(f"  {outcome.finding.id}: {outcome.verdict}")
     if args.json:
-        print(json.dumps({"suite": suite.name, "data_seeds": seeds, "episodes": sum(r.count for r in runs.values()),
+        print_json({"suite": suite.name, "data_seeds": seeds, "episodes": sum(r.count for r in runs.values()),
                           "seconds": round(sum(r.seconds for r in runs.values()), 2),
-                          "pooled": {o.finding.id: o.verdict for o in pooled}}))
+                          "pooled": {o.finding.id: o.verdict for o in pooled}})
     return 0

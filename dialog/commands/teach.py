@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 from pathlib import Path
 
@@ -16,6 +15,7 @@ from dialog.commands._arguments import (
     positive_seconds,
     resolve_time,
 )
+from dialog.commands._json import print_json
 from dialog.commands._resume import UNRECORDED_TEACH_OPTIONS, check_resume_options, continue_command
 from dialog.commands._summary import questions_in_words, scene_size, session_time
 from dialog.environment import SimulatedKitchen
@@ -221,10 +221,10 @@ def _teach(args, settings: SessionSettings, path: Path, lock: TranscriptLock, in
         manager.say(summary)
         ending = f"{saved} {summary}" if result.quit else summary
         if args.json:
-            print(json.dumps({"seed": result.seed, "strategy": result.strategy, "turns": result.turns,
+            print_json({"seed": result.seed, "strategy": result.strategy, "turns": result.turns,
                               "completed": result.completed, "quit": result.quit, "budget_spent": result.budget_spent,
                               "queries": result.queries, "accuracy": round(result.accuracy, 6),
-                              "transcript": str(path), "seconds": round(result.seconds, 3)}), file=out, flush=True)
+                              "transcript": str(path), "seconds": round(result.seconds, 3)}, file=out)
         if page is None:
             hold_viewer(args, viewer, input_stream)
     finally:

@@ -7,7 +7,6 @@ learning/rl/policy_file.py writes the policy (TOML + NPZ, no pickle).
 from __future__ import annotations
 
 import argparse
-import json
 
 from dialog.commands._arguments import (
     add_kitchen_option,
@@ -17,6 +16,7 @@ from dialog.commands._arguments import (
     price,
     seed,
 )
+from dialog.commands._json import print_json
 from dialog.output_paths import check_writable, file_argument, make_parent, writing
 from learning.errors import OutputPathError
 
@@ -82,5 +82,5 @@ def run(args: argparse.Namespace) -> int:
           f"of the last 50 training episodes {final if final is None else f'{final:.3f}'}; wrote {args.out} and "
           f"{args.out.with_suffix('.npz').name}")
     if args.json:
-        print(json.dumps({"out": str(args.out), **summary}))
+        print_json({"out": str(args.out), **summary})
     return 0

@@ -4,7 +4,6 @@ against the simulator's ground truth)."""
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 import time
 from pathlib import Path
@@ -18,6 +17,7 @@ from dialog.commands._arguments import (
     seed,
     stage,
 )
+from dialog.commands._json import print_json
 from dialog.output_paths import check_writable, file_argument, make_parent
 from learning.errors import SettingsError
 
@@ -158,7 +158,7 @@ def run_check(args: argparse.Namespace) -> int:
               f"location {row['loc_err_mm']:>5} mm")
     if args.json:
         keys = ("objects", "size_err_mm", "loc_err_mm", "features", "ms_per_scene")
-        print(json.dumps({key: result[key] for key in keys} | {"cpu_ms_per_scene": result["cpu_ms_per_scene"]}))
+        print_json({key: result[key] for key in keys} | {"cpu_ms_per_scene": result["cpu_ms_per_scene"]})
     return 0
 
 
@@ -197,7 +197,7 @@ def run_data(args: argparse.Namespace) -> int:
           f"a test pool of {len(datasets.test)}, {len(datasets.feature_names)} features; "
           f"{source_in_words(meta, time.perf_counter() - started, bool(rendering))}; {meta.get('file')}")
     if args.json:
-        print(json.dumps({"task": args.task, "kitchen": args.kitchen, "seed": args.seed, "train": sizes,
+        print_json({"task": args.task, "kitchen": args.kitchen, "seed": args.seed, "train": sizes,
                           "test": len(datasets.test), "features": len(datasets.feature_names),
-                          "file": meta.get("file"), "generator": meta.get("generator")}))
+                          "file": meta.get("file"), "generator": meta.get("generator")})
     return 0

@@ -135,6 +135,14 @@ def _check_one(strategy, name: str, state: LearningState, where: str, seed: int)
         raise fail(RULES[1], f"asked {action!r}, which the state refuses ({reason.removeprefix('Nothing to ask: ')})")
 
 
+def refuse_invalid_decision(name: str, action, reason: str, turn: int) -> StrategyCheckError:
+    """The error for a plug-in strategy that asked, on ``turn``, an ``action`` the state refuses (``reason``)."""
+    return StrategyCheckError(f"strategy '{name}' asked {action!r} on turn {turn}, which the state refuses "
+                              f"({reason.removeprefix('Nothing to ask: ').rstrip('.')}); a strategy asks only "
+                              f"affordable, admissible actions, so the episode stops here (the turns before are "
+                              f"recorded)")
+
+
 def _twin(strategy):
     """A copy of ``strategy`` as it was before this check (a strategy may remember things within an episode)."""
     try:

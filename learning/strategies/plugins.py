@@ -64,7 +64,32 @@ def load_plugin(spec: str, **options) -> Any:
             strategy.name = str(spec).strip()
         except AttributeError:  # a read-only name: reports use the spec anyway
             pass
+    _check_once(strategy, spec)
     return strategy
+
+
+#: plug-in classes loaded in this process, each checked once by ``learning.check_strategy``
+_PLUGIN_CLASSES: set[type] = set()
+
+
+def _check_once(strategy, spec: str) -> None:
+    """Refuse a plug-in that breaks the strategy contract before it plays (checked once per class)."""
+    from learning.strategies.check import StrategyCheckError, check_strategy
+
+    if type(strategy) in _PLUGIN_CLASSES:
+        return
+    try:
+        check_strategy(strategy)
+    except StrategyCheckError as error:
+        broken = str(error).removeprefix(f"{getattr(strategy, 'name', '')} ")
+        raise StrategyCheckError(f"strategy '{spec}' is refused (learning.check_strategy): a strategy {broken}") \
+            from None
+    _PLUGIN_CLASSES.add(type(strategy))
+
+
+def is_plugin(strategy) -> bool:
+    """True for a strategy built from ``module.path:ClassName`` (the user's code, held to the contract)."""
+    return type(strategy) in _PLUGIN_CLASSES
 
 
 def plugin_file_label(spec: str) -> str:

@@ -37,6 +37,20 @@ class NeedsArguments(MyStrategy):
         self.level = level
 
 
+class Broken(Strategy):
+    def choose(self, state, rng):
+        return Decision(LabelQuery(999), "Object 999, please.")
+
+
+class BreaksInTheKitchen(Strategy):
+    """Keeps the contract on check_strategy's small scenes, asks one past the last object of a kitchen scene."""
+
+    def choose(self, state, rng):
+        if len(state.scene_X) > 6 and state.can_afford(LabelQuery(0)):
+            return Decision(LabelQuery(len(state.scene_X)), "The one after the last.")
+        return Decision(NoQuery(), "Nothing to ask.")
+
+
 NOT_A_CLASS = 3
 '''
 
@@ -158,3 +172,56 @@ def test_a_teach_session_records_a_plugin_and_its_resume_checks_it_still_loads(t
     assert err.startswith(f"teachbot teach: {path}: line 1: the session header's strategy can't be loaded now: "
                           "strategy 'learning.strategies.gone:EveryOtherTurn': can't import module") and \
         len(err.splitlines()) == 1
+
+
+# -- a plug-in that returns an invalid action is refused, not mended into quiet turns (issue 42, case 1) --------
+def test_a_plugin_that_breaks_the_contract_is_refused_when_loaded(mypkg):
+    with pytest.raises(SettingsError) as refused:
+        make_strategy(f"{mypkg}:Broken")
+    message = str(refused.value)
+    assert message.startswith("strategy 'mypkg.mystrategy:Broken' is refused (learning.check_strategy): a strategy "
+                              "asks only affordable, admissible actions: on ") and "object 999" in message
+    assert "\n" not in message
+
+
+@pytest.mark.parametrize("command", [
+    ["demo", "--turns", "2"],
+    ["teach", "--teacher", "scripted", "--turns", "2", "--no-pictures"],
+])
+def test_demo_and_teach_refuse_a_broken_plugin_in_one_line_before_playing(mypkg, command, tmp_path, capsys):
+    path = tmp_path / "t.jsonl"
+    with pytest.raises(SystemExit) as exited:
+        main([*command, "--strategy", f"{mypkg}:Broken", "--transcript", str(path)])
+    assert exited.value.code == 2 and not path.exists()
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "strategy 'mypkg.mystrategy:Broken' is refused" in err, err
+
+
+def test_regress_refuses_a_broken_plugin(mypkg, tmp_path, capsys):
+    assert main(["regress", "--suite", str(write_suite(tmp_path)), "--results", str(tmp_path / "out"), "--workers",
+                 "1", "--strategies", f"{mypkg}:Broken", "--no-progress"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "strategy 'mypkg.mystrategy:Broken' is refused" in err, err
+
+
+@pytest.mark.parametrize("command", [
+    ["demo", "--turns", "3"],
+    ["teach", "--teacher", "scripted", "--turns", "3", "--no-pictures"],
+])
+def test_the_first_invalid_decision_of_a_plugin_stops_the_episode_in_one_line(mypkg, command, tmp_path, capsys):
+    path = tmp_path / "t.jsonl"
+    assert make_strategy(f"{mypkg}:BreaksInTheKitchen")  # passes check_strategy's small scenes
+    assert main([*command, "--strategy", f"{mypkg}:BreaksInTheKitchen", "--transcript", str(path)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.splitlines()[-1].startswith(f"teachbot {command[0]}: strategy 'mypkg.mystrategy:BreaksInTheKitchen' "
+                                           "asked LabelQuery(object_index=12, kind='label') on turn 1, which the "
+                                           "state refuses (label query object 12 is not an object index"), err
+    assert "Traceback" not in err
+
+
+def test_regress_stops_at_the_first_invalid_decision_of_a_plugin(mypkg, tmp_path, capsys):
+    code = main(["regress", "--suite", str(write_suite(tmp_path)), "--results", str(tmp_path / "out"), "--workers",
+                 "1", "--strategies", f"{mypkg}:BreaksInTheKitchen", "--no-progress"])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and "strategy 'mypkg.mystrategy:BreaksInTheKitchen' asked LabelQuery(" in err, err
+    assert "Traceback" not in err
