@@ -7,7 +7,10 @@ order, ``--repeats`` times each, on half the episodes and on all of them. The fi
 apart (the nodes start their worker processes and import the project). A line through the two sizes (medians)
 splits each way's wall time into a fixed part (local: starting the worker processes, which load the data
 sets; Ray: dispatch) and a part per episode; the overhead per episode is Ray's part per episode minus the
-local one. The episodes' own CPU time is summed too: the same work on both.
+local one. On a machine shared with other work, wall time also depends on the scheduler's shares (with
+the kernel's autogroup, each Ray node in its own session gets a share of its own, the local workers share
+this script's), so the CPU time is measured too: the episodes' own, and all the rest this process, its
+local workers and every process of the cluster spent during the round (``overhead``).
 
     python scripts/bench_ray.py --suite smoke --json        # last line: one JSON object
 """
@@ -29,11 +32,36 @@ from dialog.experiments.runner import episode_specs, run_locally, run_on_ray
 from dialog.experiments.suite import load_suite
 from learning.errors import TeachbotError
 
+TICKS = os.sysconf("SC_CLK_TCK")
 
-def timed(run, *arguments, **options) -> dict:
-    began = time.perf_counter()
+
+def process_cpu(pids: set[int]) -> float:
+    """CPU seconds the running processes ``pids`` have used so far (user + system, from /proc)."""
+    total = 0
+    for pid in pids:
+        try:
+            fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        total += int(fields[11]) + int(fields[12])
+    return total / TICKS
+
+
+def machine_cpu(cluster) -> float:
+    """CPU seconds of this process, its finished children (local workers) and the processes of ``cluster``
+    (None: a local round, which the idle cluster's housekeeping is not charged to)."""
+    times = os.times()
+    own = times.user + times.system + times.children_user + times.children_system
+    return own + (0.0 if cluster is None else process_cpu(cluster.pids()))
+
+
+def timed(cluster, run, *arguments, **options) -> dict:
+    """Wall time, the episodes' own CPU time, and the CPU time everything around them took (``overhead``)."""
+    began, cpu = time.perf_counter(), machine_cpu(cluster)
     results = run(*arguments, **options)
-    return {"seconds": time.perf_counter() - began, "cpu_seconds": sum(r["cpu_seconds"] for r in results)}
+    episodes = sum(r["cpu_seconds"] for r in results)
+    return {"seconds": time.perf_counter() - began, "cpu_seconds": episodes,
+            "overhead_cpu": machine_cpu(cluster) - cpu - episodes}
 
 
 def per_episode(small: float, large: float, n_small: int, n_large: int) -> tuple[float, float]:
@@ -50,11 +78,11 @@ def measure(suite_name: str, nodes: int, repeats: int, folder: Path) -> dict:
     rounds: dict[str, list[dict]] = {"local half": [], "local all": [], "ray half": [], "ray all": []}
     with loopback_cluster(nodes=nodes, cpus=1) as cluster:
         os.environ.update(cluster.environment)  # before ray is imported: this driver speaks with the token
-        cold = timed(run_on_ray, specs, cluster.address, progress=False)
+        cold = timed(cluster, run_on_ray, specs, cluster.address, progress=False)
         for _ in range(repeats):  # rotating order, so that a change of load falls on all four alike
             for name, chosen in (("half", half), ("all", specs)):
-                rounds[f"local {name}"].append(timed(run_locally, chosen, workers=nodes, progress=False))
-                rounds[f"ray {name}"].append(timed(run_on_ray, chosen, cluster.address, progress=False))
+                rounds[f"local {name}"].append(timed(None, run_locally, chosen, workers=nodes, progress=False))
+                rounds[f"ray {name}"].append(timed(cluster, run_on_ray, chosen, cluster.address, progress=False))
         import ray
 
         ray.shutdown()
@@ -69,7 +97,13 @@ def measure(suite_name: str, nodes: int, repeats: int, folder: Path) -> dict:
             "ray_fixed_s": round(ray_fixed, 2), "ray_ms_per_episode": round(1000 * ray_each, 1),
             "overhead_ms_per_episode": round(1000 * (ray_each - local_each), 1),
             "cpu_seconds": {name: round(statistics.median(r["cpu_seconds"] for r in runs), 2)
-                            for name, runs in rounds.items()}}
+                            for name, runs in rounds.items()},
+            "overhead_cpu_seconds": {name: round(statistics.median(r["overhead_cpu"] for r in runs), 2)
+                                     for name, runs in rounds.items()},
+            "local_overhead_cpu_ms_per_episode": round(1000 * statistics.median(
+                r["overhead_cpu"] for r in rounds["local all"]) / len(specs), 1),
+            "ray_overhead_cpu_ms_per_episode": round(1000 * statistics.median(
+                r["overhead_cpu"] for r in rounds["ray all"]) / len(specs), 1)}
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -96,6 +130,9 @@ def main(argv: list[str] | None = None) -> int:
     print(f"  Ray's overhead per episode: {figures['overhead_ms_per_episode']} ms; the first Ray round on the new "
           f"cluster took {figures['ray_cold_seconds']} s for all {figures['episodes']} episodes")
     print(f"  the episodes' CPU time (s, medians): {figures['cpu_seconds']}")
+    print(f"  CPU time around the episodes (this process, local workers, the cluster's processes) per episode: "
+          f"local {figures['local_overhead_cpu_ms_per_episode']} ms, Ray {figures['ray_overhead_cpu_ms_per_episode']}"
+          " ms")
     if args.json:
         print(json.dumps(figures))
     return 0

@@ -30,7 +30,7 @@ LOOPBACK = "127.0.0.1"
 STARTUP_SECONDS = 180.0  # a loaded two-core machine takes a while to start a Ray node
 
 
-NODE_ATTEMPTS = 3
+NODE_ATTEMPTS = 5  # Ray gives a raylet 30 s to register; a loaded machine can miss that more than once
 
 
 class NodeDied(SetupError):
