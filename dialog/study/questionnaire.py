@@ -65,7 +65,8 @@ def ask_terminal(items, read_line, write) -> list[dict] | None:
 
 def ask_web(items, teacher) -> list[dict]:
     """Each item's answer from the page's form (``dialog.web.teacher.WebTeacher.ask_screen``): Likert items as
-    radio buttons, free text as a text box; an item left empty is left out."""
+    radio buttons, free text as a text box; an item left empty is left out. A text that is not Unicode text
+    brings the form back with the reason (``text_problem``)."""
     shown = [{"kind": "likert", "text": item.text, "low": 1, "high": item.points, "low_label": item.anchors[0],
               "high_label": item.anchors[1]} if item.kind == "likert" else {"kind": "text", "text": item.text}
              for item in items]
