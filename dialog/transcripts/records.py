@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import json
 import math
-import re
+import unicodedata
 
 import numpy as np
 
@@ -23,18 +23,21 @@ from learning.errors import TranscriptError
 
 ANSWER_KINDS = ("answer", "absent", "skip", "dont_know", "late", "none")
 CHANNELS = ("typed", "button", "click")  # how a page's answer line came (dialog/web/messages.py makes them)
-SURROGATE = re.compile("[\ud800-\udfff]")
 TEXT_ACCEPTED = "any Unicode text (letters, digits, punctuation, emoji)"
 
 
-def text_problem(text: str) -> str:
+def text_problem(text: str, controls: str | None = None) -> str:
     """Why typed text can't be recorded ('' when it can): a lone surrogate (``"\\ud800"``, which a JSON
-    escape or a page can carry) is no Unicode character, and no UTF-8 file can hold it."""
-    found = SURROGATE.search(text)
-    if found is None:
-        return ""
-    return (f"character {found.start() + 1} is U+{ord(found.group()):04X}, half of a surrogate pair, which is not a "
-            "character of its own")
+    escape or a page can carry) is no Unicode character, and no UTF-8 file can hold it. With ``controls``, a
+    control character other than those is refused too (the page's one-line and free-text fields)."""
+    for position, ch in enumerate(text, start=1):
+        category = unicodedata.category(ch)
+        if category == "Cs":
+            return (f"character {position} is U+{ord(ch):04X}, half of a surrogate pair, which is not a "
+                    "character of its own")
+        if controls is not None and category == "Cc" and ch not in controls:
+            return f"character {position} is U+{ord(ch):04X}, a control character"
+    return ""
 
 
 def action_record(action: Action) -> dict:

@@ -13,9 +13,9 @@ from __future__ import annotations
 
 import json
 import math
-import unicodedata
 from dataclasses import dataclass
 
+from dialog.transcripts.records import text_problem
 from learning.errors import MessageError
 
 MAX_MESSAGE_BYTES = 4096
@@ -93,8 +93,8 @@ def read_message(message: dict, asked: Asked | None, resolve_click=None) -> Page
 def _line(kind: str, message: dict, asked: Asked, resolve_click) -> tuple[str, str]:
     if kind == "typed":
         text = message.get("text")
-        if not isinstance(text, str) or len(text) > MAX_TYPED_CHARS or _text_problem(text):
-            raise MessageError(f"typed text {_shown(text)}{_text_problem(text)}; accepted: one line of at most "
+        if not isinstance(text, str) or len(text) > MAX_TYPED_CHARS or _why(text, ""):
+            raise MessageError(f"typed text {_shown(text)}{_why(text, '')}; accepted: one line of at most "
                                f"{MAX_TYPED_CHARS} characters, without control characters")
         return text, "typed"
     if kind == "command":
@@ -150,18 +150,10 @@ def _is_whole(value) -> bool:
     return isinstance(value, int) and not isinstance(value, bool)
 
 
-def _text_problem(text, allowed: str = "") -> str:
-    """Why a text from the page cannot be taken ("": it can): a lone surrogate (it has no UTF-8, so neither the
-    transcript nor the page could hold it) or a control character other than ``allowed``."""
-    if not isinstance(text, str):
-        return ""
-    for ch in text:
-        category = unicodedata.category(ch)
-        if category == "Cs":
-            return f" (it holds a lone surrogate, U+{ord(ch):04X}, which is no character)"
-        if category == "Cc" and ch not in allowed:
-            return f" (it holds a control character, U+{ord(ch):04X})"
-    return ""
+def _why(text, controls: str) -> str:
+    """`` (what is wrong)`` with a text from the page that cannot be taken (records.text_problem), else ""."""
+    problem = text_problem(text, controls) if isinstance(text, str) else ""
+    return f" ({problem})" if problem else ""
 
 
 def _shown(value) -> str:
@@ -202,8 +194,8 @@ def read_screen(message: dict, screen: dict | None) -> list:
                                    f"to {item['high']}, or none")
         elif len(answer) > MAX_FREE_TEXT:
             raise MessageError(f"item {number}: a text of {len(answer)} characters; accepted: at most {MAX_FREE_TEXT}")
-        elif _text_problem(answer, FREE_TEXT_CONTROLS):
-            raise MessageError(f"item {number}: a text{_text_problem(answer, FREE_TEXT_CONTROLS)}; accepted: plain "
+        elif _why(answer, FREE_TEXT_CONTROLS):
+            raise MessageError(f"item {number}: a text{_why(answer, FREE_TEXT_CONTROLS)}; accepted: plain "
                                "text (line breaks and tabs are fine)")
         else:
             values.append(answer.strip() or None)

@@ -82,11 +82,11 @@ DEEP = "[" * 1500 + "]" * 1500
 
 
 @pytest.mark.parametrize("message, asked, says", [
-    ({"type": "typed", "text": "\ud800zz", "question": 4}, LABEL, "lone surrogate, U+D800"),
-    ({"type": "typed", "text": "fr\x00uit", "question": 4}, LABEL, "control character, U+0000"),
-    ({"type": "typed", "text": "fruit\x1b[2J", "question": 4}, LABEL, "control character, U+001B"),
-    ({"type": "typed", "text": "fruit\x85", "question": 4}, LABEL, "control character, U+0085"),
-    ({"type": "typed", "text": "a\tb", "question": 4}, LABEL, "control character, U+0009"),
+    ({"type": "typed", "text": "\ud800zz", "question": 4}, LABEL, "U+D800, half of a surrogate pair"),
+    ({"type": "typed", "text": "fr\x00uit", "question": 4}, LABEL, "U+0000, a control character"),
+    ({"type": "typed", "text": "fruit\x1b[2J", "question": 4}, LABEL, "U+001B, a control character"),
+    ({"type": "typed", "text": "fruit\x85", "question": 4}, LABEL, "U+0085, a control character"),
+    ({"type": "typed", "text": "a\tb", "question": 4}, LABEL, "U+0009, a control character"),
     ({"type": ["concept"], "concept": "fruit", "question": 4}, LABEL, "message type [\"concept\"]"),
     ({"type": {}, "concept": "fruit", "question": 4}, LABEL, "message type {}"),
     ({"type": "concept", "concept": "fruit", "question": 4, "page_ms": int("9" * 401)}, LABEL, "page_ms 999"),
@@ -120,8 +120,8 @@ SCREEN = {"id": 7, "items": [{"kind": "likert", "low": 1, "high": 5}, {"kind": "
 
 
 @pytest.mark.parametrize("answers, screen_id, says", [
-    (["3", "fine\ud800"], 7, "item 2: a text (it holds a lone surrogate"),
-    (["3", "fine\x07"], 7, "item 2: a text (it holds a control character, U+0007)"),
+    (["3", "fine\ud800"], 7, "item 2: a text (character 5 is U+D800, half of a surrogate pair"),
+    (["3", "fine\x07"], 7, "item 2: a text (character 5 is U+0007, a control character)"),
     (["\u00b2", ""], 7, "item 1"),  # a digit int() refuses
     (["\u0663", ""], 7, "item 1"),  # an Arabic-Indic 3 is not a point of the scale's radio buttons
     (["3", ""], 7.0, "screen 7.0"),
