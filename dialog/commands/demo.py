@@ -14,7 +14,7 @@ from dialog.environment import SimulatedKitchen
 from dialog.episode import build_episode, embodied_timing
 from dialog.experiments.runner import file_label
 from dialog.manager import episode_generators
-from dialog.output_paths import file_argument
+from dialog.output_paths import file_argument, numbered
 from dialog.settings import DEFAULTS, EpisodeSettings
 from dialog.teachers.scripted import OracleTeacher
 from dialog.transcripts.jsonl import TranscriptWriter, refuse_foreign_transcript
@@ -50,13 +50,14 @@ def register(commands) -> None:
 
 def default_transcript(args: argparse.Namespace, seconds: float | None) -> Path:
     """runs/demo-<strategy>[-<task>][-<kitchen>][-embodied-<N>s]-seed<seed>.jsonl: the parts that differ from the
-    defaults name the file, so an embodied demo does not overwrite the plain demo's transcript."""
+    defaults name the file, so an embodied demo does not overwrite the plain demo's transcript; numbered (-2, -3,
+    ...) as teach's when taken, so no earlier demo is overwritten."""
     parts = [file_label(args.strategy)]
     parts += [value for value, default in ((args.task, DEFAULTS.task), (args.kitchen, DEFAULTS.kitchen))
               if value != default]
     if seconds is not None:
         parts.append(f"embodied-{seconds:g}s")
-    return Path("runs") / f"demo-{'-'.join(parts)}-seed{args.seed}.jsonl"
+    return numbered(Path("runs") / f"demo-{'-'.join(parts)}-seed{args.seed}.jsonl")
 
 
 def run(args: argparse.Namespace) -> int:

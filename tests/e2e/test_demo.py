@@ -61,8 +61,9 @@ def test_the_summary_counts_questions_in_words_and_the_json_keeps_its_counts(tmp
     assert "; 12 objects a scene (an interactive size; the thesis's experiments use 55);" in lines[-2]
 
 
-def test_default_transcript_names_say_what_differs_from_the_defaults():
+def test_default_transcript_names_say_what_differs_from_the_defaults(tmp_path, monkeypatch):
     """Issue 23 case 11: the embodied demo wrote runs/demo-dt-task-seed0.jsonl over the plain demo's transcript."""
+    monkeypatch.chdir(tmp_path)  # no earlier demo here, so no name is numbered
     from dialog.cli import build_parser
     from dialog.commands.demo import default_transcript
     parse = build_parser().parse_args
