@@ -39,7 +39,8 @@ def _same(given, recorded) -> bool:
 
 
 def differing_options(args: argparse.Namespace, settings, path: Path, defaults: argparse.Namespace) -> list[str]:
-    """``--option given differs from the recorded value`` for every option given beside --resume that the recorded session contradicts."""
+    """``--option GIVEN differs from the recorded VALUE`` for every option given beside --resume that the
+    recorded session contradicts."""
     found = []
     for option, (name, recorded_value) in SESSION_OPTIONS.items():
         if not hasattr(args, name):

@@ -1,4 +1,4 @@
-"""train-questioner says what it is doing before its slow steps and counts the episodes it averages (issue 42, case 4)."""
+"""train-questioner says what it does before its slow steps and counts the episodes it averages (issue 42, case 4)."""
 
 from __future__ import annotations
 
