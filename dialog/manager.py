@@ -23,7 +23,7 @@ from dialog.clock import VirtualClock
 from dialog.embodied import load_embodied_costs
 from dialog.environment import DEFAULT_TEST_SCENES, Environment, HasTestScenes, SupportsFetch
 from dialog.language.parsing import AnswerParser
-from dialog.language.questions import Prompt, Questioner, acknowledgement, question_text
+from dialog.language.questions import Prompt, Questioner, acknowledgement, article, question_text
 from dialog.settings import EpisodeConfig
 from dialog.teachers.conversation import Outcome, converse
 from dialog.teachers.protocol import checked_teacher
@@ -308,7 +308,8 @@ class DialogManager:
                 continue
             turn, what = self._undo_stack[-1 - len(undone)][:2]
             undone.append(turn)
-            self.teacher_tell(f"Taken back: {what} (turn {turn}). {prompt.text}")
+            self.teacher_tell(f"Taken back: {what} (turn {turn}); that question is not asked again unless I choose "
+                              f"it again. Now: {prompt.text}")
         outcome.lines, outcome.channels = lines, channels
         return outcome, undone
 
@@ -335,7 +336,7 @@ class DialogManager:
         if change.kind == "example" and change.object is None:
             self._undo_stack.append((self.turn + 1, f"the {change.concept} from the pantry", change))
         elif change.kind == "example":
-            self._undo_stack.append((self.turn + 1, f"number {change.object + 1} is {change.concept}", change))
+            self._undo_stack.append((self.turn + 1, f"number {change.object + 1} is {article(change.concept)}", change))
         elif change.kind == "features":
             self._undo_stack.append((self.turn + 1, f"the choice of {len(change.features)} features", change))
         return extra
