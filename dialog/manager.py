@@ -23,7 +23,7 @@ from dialog.clock import VirtualClock
 from dialog.embodied import load_embodied_costs
 from dialog.environment import DEFAULT_TEST_SCENES, Environment, HasTestScenes, SupportsFetch
 from dialog.language.parsing import AnswerParser
-from dialog.language.questions import Prompt, Questioner, acknowledgement, question_text
+from dialog.language.questions import Prompt, Questioner, acknowledgement, article, question_text
 from dialog.settings import EpisodeConfig
 from dialog.teachers.conversation import Outcome, converse
 from dialog.teachers.protocol import checked_teacher
@@ -58,6 +58,10 @@ class EpisodeResult:
     seconds: float
     completed: int = 0
     quit: bool = False
+    #: embodied costs: the accuracy after the last turn that ended within the allocation's seconds and how many
+    #: turns that is (the turn in progress when the seconds ran out does not count, docs/experiments.md)
+    allocation_accuracy: float | None = None
+    allocation_turns: int = 0
 
 
 def episode_generators(seed: int) -> dict[str, np.random.Generator]:
@@ -105,6 +109,7 @@ class DialogManager:
         self.embodied = load_embodied_costs() if config.seconds is not None else None  # dialog/embodied.py
         self._pointing: tuple | None = None  # ((scene id, last pointed), each object's expected pointing seconds)
         self._last_pointed: int | None = None  # the scene object the arm points at now (None: at rest)
+        self._within_allocation: tuple[float | None, int] = (None, 0)  # (accuracy, turns) ended within the seconds
 
     # -- episode ------------------------------------------------------------------
     def header(self) -> dict:
@@ -147,6 +152,7 @@ class DialogManager:
                      "none": kinds["none"]},
             accuracy=self.test_accuracy(), transcript=str(self.transcript.path),
             seconds=seconds, completed=self.turn, quit=self.quit,
+            allocation_accuracy=self._within_allocation[0], allocation_turns=self._within_allocation[1],
         )
 
     # -- the clock and the world ---------------------------------------------------
@@ -226,7 +232,7 @@ class DialogManager:
             outcome = Outcome("none")
             if self.embodied is not None:
                 self.clock.advance(self.embodied.quiet)
-            self.say(f"Turn {number:>3} · Robot stays quiet. ({explanation})")
+            self.say(f"{self._turn_label(number, start)} · Robot stays quiet. ({explanation})")
         else:
             if action.kind == "label":
                 record["gesture"] = self.env.point_at(scene, action.object_index)
@@ -246,7 +252,8 @@ class DialogManager:
             outcome, undone = self._ask(prompt)
             if outcome.kind == "quit":
                 self.quit = True
-                self.say(f"Turn {number:>3} · the teacher ended the session ({outcome.note or 'quit'}).")
+                self.say(f"{self._turn_label(number, start)} · the teacher ended the session "
+                         f"({outcome.note or 'quit'}).")
                 return None
             for _ in undone:
                 self._undo()
@@ -261,7 +268,7 @@ class DialogManager:
                            f"{record['fetch_failed']['reason']}. I'll go on without one.")
             self._notify("on_answer", action, outcome, scene)
             lead = f"Robot (pointing at object {action.object_index + 1})" if action.kind == "label" else "Robot"
-            self.say(f"Turn {number:>3} · {lead}: {prompt.text}   Teacher: {outcome.raw}")
+            self.say(f"{self._turn_label(number, start)} · {lead}: {prompt.text}   Teacher: {outcome.raw}")
         record = self._close_turn(record, action, outcome)
         if action.kind != "none" and message:  # acknowledged only once the turn is on disk
             self.teacher_tell(message)
@@ -279,6 +286,8 @@ class DialogManager:
         })
         if self.embodied is not None:  # how long the turn took
             record["seconds"] = round(record["ended"] - record["time"], 3)
+            if record["ended"] <= self.config.seconds:
+                self._within_allocation = (record["accuracy"], record["turn"])
         self.transcript.write(record)
         self.turn += 1
         self._notify("on_turn", record, self.scene)
@@ -307,9 +316,14 @@ class DialogManager:
                 continue
             turn, what = self._undo_stack[-1 - len(undone)][:2]
             undone.append(turn)
-            self.teacher_tell(f"Taken back: {what} (turn {turn}). {prompt.text}")
+            self.teacher_tell(f"Taken back: {what} (turn {turn}); that question is not asked again unless I choose "
+                              f"it again. Now: {prompt.text}")
         outcome.lines, outcome.channels = lines, channels
         return outcome, undone
+
+    def _turn_label(self, number: int, start: float) -> str:
+        """``Turn  12`` and, with embodied costs, the clock when the turn began: ``Turn  12 at 143.2 s``."""
+        return f"Turn {number:>3}" + ("" if self.embodied is None else f" at {start:.1f} s")
 
     def teacher_tell(self, text: str) -> None:
         self.teacher.tell(text)
@@ -330,7 +344,7 @@ class DialogManager:
         if change.kind == "example" and change.object is None:
             self._undo_stack.append((self.turn + 1, f"the {change.concept} from the pantry", change))
         elif change.kind == "example":
-            self._undo_stack.append((self.turn + 1, f"number {change.object + 1} is {change.concept}", change))
+            self._undo_stack.append((self.turn + 1, f"number {change.object + 1} is {article(change.concept)}", change))
         elif change.kind == "features":
             self._undo_stack.append((self.turn + 1, f"the choice of {len(change.features)} features", change))
         return extra

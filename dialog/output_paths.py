@@ -8,7 +8,10 @@ path over the system's limit and a loop of symbolic links each get their own
 message. ``file_argument`` is the ``type=`` of every command-line option
 naming an output file: ``newdir/`` (a trailing separator) is a folder, not a
 file name. Every command checks its outputs this way before its work starts
-and creates missing folders as it writes (one rule, docs/dialog.md).
+and creates missing folders as it writes; a file named on the command line in a
+missing folder outside the current folder (``/nonexistent/dir/t.jsonl``) is
+refused by ``file_argument`` (one rule, docs/dialog.md). ``numbered(path)`` is the next free name for a
+default output (``runs/demo-...-seed0-2.jsonl``), so no earlier run is replaced.
 ``writing(path, what)`` turns an ``OSError`` raised while writing into an
 :class:`~learning.errors.OutputPathError` naming the path and the cause, e.g.
 ``runs/a.jsonl: cannot write the transcript: no space left on device (ENOSPC)``.
@@ -65,7 +68,13 @@ def file_argument(text: str) -> Path:
     if (text.endswith(os.sep) or (os.altsep and text.endswith(os.altsep))) and not os.path.isdir(text):
         raise argparse.ArgumentTypeError(f"{text!r} ends in '{os.sep}', so it names a folder; give a file path "
                                          f"such as {text.rstrip(os.sep) or 'runs'}{os.sep}out.jsonl")
-    return Path(text)
+    path = Path(text)
+    if not path_problem(path) and not path.parent.is_dir() and not inside_current_folder(path.parent) \
+            and _existing_ancestor(path.parent).is_dir():
+        raise argparse.ArgumentTypeError(f"{text}: the folder {path.parent} does not exist (missing folders are "
+                                         f"created only inside the current folder, {Path.cwd()}); create it first "
+                                         f"or give a path in an existing folder")
+    return path
 
 
 def path_problem(path: str | Path) -> str:
@@ -139,6 +148,22 @@ def check_writable(path: str | Path, what: str, *, folder: bool = False) -> Path
     if free == 0:
         return _refuse(path, what, errno.ENOSPC)
     return path
+
+
+def inside_current_folder(path: str | Path) -> bool:
+    """True when ``path`` is the current folder or lies below it (where missing folders may be created)."""
+    return Path(os.path.abspath(path)).is_relative_to(Path.cwd())
+
+
+def numbered(path: str | Path) -> Path:
+    """``path`` if nothing is there yet, else the first free ``NAME-2.EXT``, ``NAME-3.EXT``, ...: a default output
+    name never replaces an earlier run's file (teach's and demo's transcripts, demo's episode page)."""
+    path = Path(path)
+    number = 2
+    candidate = path
+    while candidate.exists():
+        candidate, number = path.with_name(f"{path.stem}-{number}{path.suffix}"), number + 1
+    return candidate
 
 
 def _pseudo_file_system(folder: Path) -> bool:

@@ -22,7 +22,7 @@ from contextlib import contextmanager
 from pathlib import Path
 
 from dialog.commands._arguments import seconds
-from dialog.output_paths import check_writable, file_argument, from_os_error, path_problem
+from dialog.output_paths import check_writable, file_argument, from_os_error, numbered, path_problem
 from learning.errors import OutputPathError
 
 
@@ -109,11 +109,13 @@ def stop_viewer(viewer) -> dict | None:
 
 
 def page_path(path: Path, name: str) -> Path:
-    """``path``, or ``path/name`` when ``path`` is a folder (said on standard error); a path that can't even be
-    looked up (a name too long, a loop of links) is refused by ``check_writable``."""
+    """``path``, or ``path/name`` when ``path`` is a folder (numbered as ``name-2.html``, ... when taken, so an
+    earlier page is kept; said on standard error); a path that can't even be looked up (a name too long, a loop of
+    links) is refused by ``check_writable``."""
     if not path_problem(path) and path.is_dir():
-        print(f"{path} is a folder: the page goes to {path / name}", file=sys.stderr)
-        return path / name
+        page = numbered(path / name)
+        print(f"{path} is a folder: the page goes to {page}", file=sys.stderr)
+        return page
     return path
 
 

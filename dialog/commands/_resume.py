@@ -39,18 +39,24 @@ def _same(given, recorded) -> bool:
 
 
 def differing_options(args: argparse.Namespace, settings, path: Path, defaults: argparse.Namespace) -> list[str]:
-    """``--option given (recorded)`` for every option given beside --resume that the recorded session contradicts."""
+    """``--option GIVEN differs from the recorded VALUE`` for every option given beside --resume that the
+    recorded session contradicts."""
     found = []
     for option, (name, recorded_value) in SESSION_OPTIONS.items():
         if not hasattr(args, name):
             continue
         given, recorded = getattr(args, name), recorded_value(settings)
         if given != getattr(defaults, name, None) and not _same(given, recorded):
-            found.append(f"{option} {given} (recorded: {recorded})")
+            found.append(f"{option} {_shown(given)} differs from the recorded {_shown(recorded)}")
     transcript = getattr(args, "transcript", None)
     if transcript is not None and Path(transcript).resolve() != Path(path).resolve():
-        found.append(f"--transcript {transcript} (the resumed session goes on in {path})")
+        found.append(f"--transcript {transcript} differs from the recorded session's file (it goes on in {path})")
     return found
+
+
+def _shown(value) -> str:
+    """A value as a person writes it: ``10.0`` is 10, ``0.5`` is 0.5, anything else as it is."""
+    return f"{value:g}" if isinstance(value, float) else str(value)
 
 
 def check_resume_options(args: argparse.Namespace, settings, path: Path, defaults: argparse.Namespace) -> None:
@@ -58,8 +64,9 @@ def check_resume_options(args: argparse.Namespace, settings, path: Path, default
     when no option is given), naming each of them, and a weights file that changed since it was recorded."""
     differing = differing_options(args, settings, path, defaults)
     if differing:
-        raise TranscriptError(f"{path}: a resumed session keeps its recorded settings, but {'; '.join(differing)} "
-                              "differ; leave them out, or start a new session without --resume")
+        raise TranscriptError(f"{path}: a resumed session keeps its recorded settings, but {'; '.join(differing)}; "
+                              f"leave {'it' if len(differing) == 1 else 'them'} out, or start a new session without "
+                              f"--resume")
     if settings.weights is not None:
         check_weights_unchanged(weights_from_header(settings.weights, path), path)
 

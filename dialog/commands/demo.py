@@ -14,7 +14,7 @@ from dialog.environment import SimulatedKitchen
 from dialog.episode import build_episode, embodied_timing
 from dialog.experiments.runner import file_label
 from dialog.manager import episode_generators
-from dialog.output_paths import file_argument
+from dialog.output_paths import file_argument, numbered
 from dialog.settings import DEFAULTS, EpisodeSettings
 from dialog.teachers.scripted import OracleTeacher
 from dialog.transcripts.jsonl import TranscriptWriter, refuse_foreign_transcript
@@ -50,13 +50,14 @@ def register(commands) -> None:
 
 def default_transcript(args: argparse.Namespace, seconds: float | None) -> Path:
     """runs/demo-<strategy>[-<task>][-<kitchen>][-embodied-<N>s]-seed<seed>.jsonl: the parts that differ from the
-    defaults name the file, so an embodied demo does not overwrite the plain demo's transcript."""
+    defaults name the file, so an embodied demo does not overwrite the plain demo's transcript; numbered (-2, -3,
+    ...) as teach's when taken, so no earlier demo is overwritten."""
     parts = [file_label(args.strategy)]
     parts += [value for value, default in ((args.task, DEFAULTS.task), (args.kitchen, DEFAULTS.kitchen))
               if value != default]
     if seconds is not None:
         parts.append(f"embodied-{seconds:g}s")
-    return Path("runs") / f"demo-{'-'.join(parts)}-seed{args.seed}.jsonl"
+    return numbered(Path("runs") / f"demo-{'-'.join(parts)}-seed{args.seed}.jsonl")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -119,16 +120,23 @@ def _watch_in_page(args, environment, pace: float, play) -> None:
 
 
 def _print_summary(args: argparse.Namespace, result, environment, manager) -> None:
-    used = "" if manager.embodied is None else \
-        f"time used {manager.clock.now():.0f} of {manager.config.seconds:g} s in {result.completed} turns; "
-    line = (f"Accuracy on {args.task} held-out scenes: {result.accuracy:.1%} "
+    score, when, used = result.accuracy, "", ""
+    if manager.embodied is not None:  # scored at the allocation's end: a turn that ends past it does not count
+        allocation = manager.config.seconds
+        score = result.allocation_accuracy
+        when = f" after {allocation:g} s (turn {result.allocation_turns}, the last that ended within them)"
+        if score is None:
+            score, when = float("nan"), f" after {allocation:g} s (no turn ended within them)"
+        used = f"time used {manager.clock.now():.0f} of {allocation:g} s in {result.completed} turns; "
+    shown = "none" if score != score else f"{score:.1%}"
+    line = (f"Accuracy on {args.task} held-out scenes{when}: {shown} "
             f"(chance {1 / len(environment.concepts):.0%}); budget spent {result.budget_spent:g} of {args.budget:g}; "
             f"questions: {questions_in_words(result.queries)}; {scene_size(environment.world.task)}; "
             f"{used}{result.seconds:.1f} s. "
             f"Transcript: {result.transcript}")
     print(f"\n{line}", flush=True)
     if args.json:
-        summary = {key: asdict(result)[key] for key in SUMMARY_KEYS}
+        summary = {key: asdict(result)[key] for key in SUMMARY_KEYS} | {"accuracy": score}
         summary["queries"] = {kind: summary["queries"][kind] for kind in ("label", "demo", "feature", "none")}
         print_json(summary)
     return line

@@ -21,7 +21,7 @@ from dialog.commands._summary import questions_in_words, scene_size, session_tim
 from dialog.environment import SimulatedKitchen
 from dialog.episode import embodied_timing
 from dialog.experiments.runner import file_label
-from dialog.output_paths import check_writable, file_argument
+from dialog.output_paths import check_writable, file_argument, numbered
 from dialog.session import TEACHERS, SessionSettings, open_session
 from dialog.transcripts.jsonl import read_session
 from dialog.transcripts.lock import TranscriptLock
@@ -80,11 +80,8 @@ def teach_defaults() -> argparse.Namespace:
 
 
 def _default_transcript(args, strategy: str) -> Path:
-    base = Path("runs") / f"teach-{args.task}-{file_label(strategy)}-seed{args.seed}"
-    path, number = base.with_suffix(".jsonl"), 2
-    while path.exists():
-        path, number = Path(f"{base}-{number}.jsonl"), number + 1
-    return path
+    """runs/teach-<task>-<strategy>-seed<seed>.jsonl, numbered (-2, -3, ...) when taken."""
+    return numbered(Path("runs") / f"teach-{args.task}-{file_label(strategy)}-seed{args.seed}.jsonl")
 
 
 def _settings(args) -> SessionSettings:

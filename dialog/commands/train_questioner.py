@@ -72,15 +72,24 @@ def run(args: argparse.Namespace) -> int:
     print(f"training a questioner with masked PPO for {config.steps} steps on {config.envs} environment(s), "
           f"seed {config.seed}", flush=True)
     policy, summary = train(config, progress=not args.no_progress,
-                            provenance={"commit": git_commit(), "price": args.price})
+                            provenance={"commit": git_commit(), "price": args.price},
+                            say=lambda text: print(text, flush=True))
     make_parent(args.out, "policy file")
     with writing(args.out, "policy file"):
         save_policy(args.out, policy, "written by teachbot train-questioner: a masked PPO questioning policy\n"
                                       "run it with --strategy rl:" + str(args.out))
-    final = summary["final_accuracy_last_50"]
-    print(f"{summary['steps']} steps, {summary['episodes']} episodes in {summary['seconds']:.0f} s; final accuracy "
-          f"of the last 50 training episodes {final if final is None else f'{final:.3f}'}; wrote {args.out} and "
-          f"{args.out.with_suffix('.npz').name}")
+    print(f"{summary['steps']} steps, {summary['episodes']} episodes in {summary['seconds']:.0f} s; "
+          f"{final_accuracy_words(summary)}; wrote {args.out} and {args.out.with_suffix('.npz').name}")
     if args.json:
         print_json({"out": str(args.out), **summary})
     return 0
+
+
+def final_accuracy_words(summary: dict) -> str:
+    """"final accuracy of the last 50 training episodes 0.585", with the real count when fewer ended."""
+    count, final = summary["final_accuracy_episodes"], summary["final_accuracy_last_50"]
+    if not count:
+        return "no training episode ended, so no final accuracy"
+    last = "the one training episode" if count == 1 else \
+        (f"all {count} training episodes" if count == summary["episodes"] else f"the last {count} training episodes")
+    return f"final accuracy of {last} {final:.3f}"

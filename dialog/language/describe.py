@@ -158,8 +158,29 @@ class SceneDescriber:
         else:
             self.size_words = [""] * n
 
-    def describe(self, index: int) -> str:
-        """"the big red round thing near the fridge" (as much as the robot perceives)."""
+    def describe(self, index: int, distinct: bool = True) -> str:
+        """"the big red round thing near the fridge" (as much as the robot perceives); when another object of the
+        scene reads the same, its size in centimetres is added (and, should that tie too, its number), so no
+        two objects of a scene share a description. ``distinct=False``: the words alone (as before issue 42)."""
+        text = self._words(index)
+        if not distinct:
+            return text
+        if getattr(self, "_all_words", None) is None:
+            self._all_words = [self._words(other) for other in range(self.scene.n_objects)]
+        alike = [other for other, words in enumerate(self._all_words) if words == text]
+        if len(alike) < 2:
+            return text
+        sized = self._with_size(index)
+        if self.sizes is not None and sum(self._with_size(other) == sized for other in alike) == 1:
+            return sized
+        return f"{text} (number {index + 1})"
+
+    def _with_size(self, index: int) -> str:
+        if self.sizes is None:
+            return self._words(index)
+        return f"{self._words(index)}, {'x'.join(f'{v * 100:.0f}' for v in self.sizes[index])} cm"
+
+    def _words(self, index: int) -> str:
         words = [self.size_words[index], self.colour_names[index]]
         if self.sizes is not None:
             words += shape_words(*self.sizes[index])

@@ -113,8 +113,10 @@ class _Progress:
             self._bar.stop()
 
 
-def train(config: TrainingConfig, progress: bool = True, provenance: dict | None = None):
-    """Train; returns (the policy, a summary dict with the seconds, episodes and recent accuracy)."""
+def train(config: TrainingConfig, progress: bool = True, provenance: dict | None = None, say=None):
+    """Train; returns (the policy, a summary dict with the seconds, episodes and recent accuracy). ``say`` (a
+    function of one line) hears what is being done before each slow step (data sets, workers, training)."""
+    say = say or (lambda text: None)
     MaskablePPO = require_rl()
     import torch
     from stable_baselines3.common.callbacks import BaseCallback
@@ -123,9 +125,12 @@ def train(config: TrainingConfig, progress: bool = True, provenance: dict | None
 
     torch.set_num_threads(1)
     started = time.perf_counter()
+    say("loading the training data sets (rendered in the simulated kitchen on the first run, then cached)...")
     probe = make_env(config.env)()  # validates the options here, once, and renders the data sets if needed
     layout = probe.layout
     probe.close()
+    say(f"starting {config.envs} environment{'s' if config.envs > 1 else ''}"
+        f"{' in worker processes' if config.envs > 1 else ''}, then training...")
     vec_cls = SubprocVecEnv if config.envs > 1 else DummyVecEnv
     vec_kwargs = {"start_method": "spawn"} if config.envs > 1 else None
     venv = make_vec_env(make_env(config.env), n_envs=config.envs, seed=config.seed, vec_env_cls=vec_cls,
@@ -149,7 +154,8 @@ def train(config: TrainingConfig, progress: bool = True, provenance: dict | None
     seconds = time.perf_counter() - started
     recent = tracker.accuracies[-50:]
     summary = {"steps": int(model.num_timesteps), "episodes": tracker.episodes, "seconds": round(seconds, 1),
-               "final_accuracy_last_50": round(float(np.mean(recent)), 4) if recent else None}
+               "final_accuracy_last_50": round(float(np.mean(recent)), 4) if recent else None,
+               "final_accuracy_episodes": len(recent)}
     record = {**(provenance or {}), **{f"ppo_{k}": v for k, v in asdict(config).items() if k != "env"},
               **{f"env_{k}": _plain(v) for k, v in probe.settings.__dict__.items()},
               "algorithm": "MaskablePPO (sb3-contrib)", "hidden_layers": list(HIDDEN), **summary}

@@ -307,9 +307,12 @@ def question_difference(recorded: str, action: Action, describer, concepts) -> s
     asked = question_text(action, description=description, concepts=concepts, n_objects=describer.scene.n_objects)
     if recorded == asked:
         return ""
-    if action.kind == "label":  # a transcript from before the teacher's viewpoint: the old side words
-        old = SceneDescriber(describer.scene, describer.locations, OLD_WORLD_VIEWPOINT).describe(action.object_index)
-        if recorded == question_text(action, description=old, concepts=concepts, n_objects=describer.scene.n_objects):
-            return ""
+    if action.kind == "label":  # a transcript from before the teacher's viewpoint, or before distinct descriptions
+        old = SceneDescriber(describer.scene, describer.locations, OLD_WORLD_VIEWPOINT)
+        for earlier in (old.describe(action.object_index), old.describe(action.object_index, distinct=False),
+                        describer.describe(action.object_index, distinct=False)):
+            if recorded == question_text(action, description=earlier, concepts=concepts,
+                                         n_objects=describer.scene.n_objects):
+                return ""
     return (f"the recorded question {recorded!r} is not the replay's {asked!r}: the transcript was made with another "
             "seed, task or kitchen")

@@ -81,3 +81,36 @@ def test_projection_and_annotation_mark_the_object():
     assert image.shape == (100, 200, 3) and not np.array_equal(image, rgb[:, :, ::-1])
     ring = image[50, 100 - 31:100 + 32]  # the highlight ring crosses this row
     assert (ring[:, 1] > 180).any()
+
+
+def test_objects_that_read_alike_get_their_size_or_their_number(tmp_path):
+    """Issue 42, case 7: two objects of one scene were both "the blue round tall thing at the back left"."""
+    blue, spot = (0.15, 0.3, 0.75), (-0.3, 0.3, 0)
+    red, green = (0.8, 0.1, 0.1), (0.3, 0.7, 0.2)
+    scene = scene_with([blue, blue, blue, red, red, green, green],
+                       [(0.06, 0.06, 0.14), (0.07, 0.07, 0.16), (0.07, 0.07, 0.16), (0.3, 0.1, 0.05),
+                        (0.3, 0.12, 0.05), (0.02, 0.02, 0.02), (0.02, 0.03, 0.02)],
+                       [spot, spot, spot, (0.4, 0.1, 0), (0.1, -0.2, 0), (0.0, 0.0, 0), (-0.28, 0.14, 0)])
+    describer = SceneDescriber(scene, LOCATIONS)
+    alone = describer.describe(0, distinct=False)
+    assert alone == describer.describe(1, distinct=False) == describer.describe(2, distinct=False)
+    assert describer.describe(0) == f"{alone}, 6x6x14 cm"  # its size tells it apart
+    assert describer.describe(1) == f"{alone} (number 2)" and describer.describe(2) == f"{alone} (number 3)"
+    assert describer.describe(3) == describer.describe(3, distinct=False)  # one of a kind: unchanged
+    descriptions = [describer.describe(i) for i in range(7)]
+    assert len(set(descriptions)) == 7
+
+
+def test_every_object_of_the_demo_scenes_is_described_distinctly():
+    from dialog.environment import SimulatedKitchen
+
+    kitchen = SimulatedKitchen(task="pack-lunchbox", kitchen="kitchen-1", seed=0)
+    try:
+        rng = np.random.default_rng(0)
+        for _ in range(6):
+            scene = kitchen.next_scene(rng)
+            describer = SceneDescriber(scene, kitchen.locations, kitchen.viewpoint)
+            texts = [describer.describe(i) for i in range(scene.n_objects)]
+            assert len(set(texts)) == len(texts), texts
+    finally:
+        kitchen.close()

@@ -165,7 +165,8 @@ def test_undo_takes_back_the_last_answer(tmp_path):
     manager.run()
     records = read_session(tmp_path / "t.jsonl")[1]
     assert records[1]["undid"] == [1] and records[1]["answer"]["lines"] == ["undo", "undo", "a snack"]
-    assert any("Taken back: number 1 is fruit (turn 1)" in h for h in teacher.heard)
+    assert any("Taken back: number 1 is a fruit (turn 1); that question is not asked again unless I choose it "
+               "again. Now: " in h for h in teacher.heard)  # issue 42, case 7: it read "number 1 is fruit"
     assert any("nothing left to take back" in h for h in teacher.heard)
     assert records[1]["model"]["examples"] == {"main dish": 0, "snack": 1, "fruit": 0, "beverage": 0}
     assert [e.concept for e in manager.state.examples] == ["snack", "beverage"]

@@ -8,6 +8,7 @@ output are created when it is written.
 from __future__ import annotations
 
 import os
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -137,8 +138,66 @@ FOLDER_CREATED = {
 
 
 @pytest.mark.parametrize("option", sorted(FOLDER_CREATED))
-def test_every_command_creates_the_missing_folders_of_its_output(option, tmp_path, capsys):
+def test_every_command_creates_the_missing_folders_of_its_output(option, tmp_path, capsys, monkeypatch):
     suffix = SUFFIX.get(option, ".html" if "export" in option else ".md")
-    path = tmp_path / "new-folder" / "below" / ("report.md" if option == "study report --out" else f"out{suffix}")
+    monkeypatch.chdir(tmp_path)  # missing folders are created inside the current folder
+    path = Path("new-folder") / "below" / ("report.md" if option == "study report --out" else f"out{suffix}")
     assert main(FOLDER_CREATED[option](str(path))) == 0, capsys.readouterr().err
     assert path.is_file() and path.stat().st_size > 0
+
+
+# -- outside the current folder a missing folder is refused, not created (issue 42, case 2) ---------------------
+@pytest.mark.parametrize("option", ["demo --transcript", "view --export", "teach --transcript",
+                                    "world show --png", "learn-weights --out"])
+def test_a_file_in_a_missing_folder_outside_the_current_one_is_refused_and_nothing_is_created(option, tmp_path):
+    here = tmp_path / "here"
+    here.mkdir()
+    path = tmp_path / "nonexistent" / "dir" / f"out{SUFFIX[option]}"
+    line = one_line(run_cli(FILE_OUTPUTS[option](str(path)), here), f"the folder {path.parent} does not exist",
+                    "missing folders are created only inside the current folder")
+    assert line.startswith(f"teachbot {option.split()[0]}") and f": {option.split()[-1]}: {path}: the folder " in line
+    assert not (tmp_path / "nonexistent").exists()
+
+
+def test_a_demo_in_a_missing_folder_at_the_root_is_refused(tmp_path):
+    top = Path("/") / f"teachbot-missing-{os.getpid()}"
+    assert not top.exists()
+    try:
+        one_line(run_cli(["demo", "--turns", "1", "--transcript", str(top / "dir" / "t.jsonl")], tmp_path),
+                 f"the folder {top / 'dir'} does not exist")
+        assert not top.exists()
+    finally:
+        if top.exists():  # the bug: the folder was made at the file system's root
+            shutil.rmtree(top)
+
+
+def test_the_viewer_export_into_a_missing_folder_elsewhere_is_refused(tmp_path):
+    here = tmp_path / "here"
+    here.mkdir()
+    page = tmp_path / "nonexistent" / "episode.html"
+    one_line(run_cli(["demo", "--turns", "1", "--viewer-export", str(page), "--transcript", "t.jsonl"], here),
+             f"--viewer-export: {page}: the folder {page.parent} does not exist")
+    assert not page.parent.exists() and not (here / "t.jsonl").exists()
+
+
+# -- default names are numbered, never overwritten (issue 42, case 2) ------------------------------------------
+def test_every_demo_keeps_the_earlier_demos_transcript_and_page(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    pages = tmp_path / "pages"
+    pages.mkdir()
+    for _ in range(2):
+        assert main(["demo", "--turns", "1", "--viewer-export", str(pages)]) == 0, capsys.readouterr().err
+    err = capsys.readouterr().err
+    first, second = Path("runs/demo-dt-task-seed0.jsonl"), Path("runs/demo-dt-task-seed0-2.jsonl")
+    assert first.is_file() and second.is_file() and first.read_bytes() == second.read_bytes()
+    assert (pages / "episode.html").is_file() and (pages / "episode-2.html").is_file()
+    assert f"the page goes to {pages / 'episode-2.html'}" in err
+
+
+def test_the_numbered_name_is_teachs_rule(tmp_path):
+    from dialog.output_paths import numbered
+
+    path = tmp_path / "teach-pack-lunchbox-mypkg.mod.Class-seed0.jsonl"
+    assert numbered(path) == path
+    path.write_text("x")
+    assert numbered(path) == tmp_path / "teach-pack-lunchbox-mypkg.mod.Class-seed0-2.jsonl"

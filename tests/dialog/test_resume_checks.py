@@ -160,12 +160,21 @@ def test_a_changed_budget_left_is_refused(recorded, tmp_path, capsys):
 def test_options_that_contradict_the_recorded_session_are_refused_by_name(recorded, tmp_path, capsys):
     message = refused(tmp_path, capsys, recorded[:3], "--seed", "5", "--task", "sort-groceries", "--turns", "3",
                       "--strategy", "passive", "--kitchen", "kitchen-2", "--budget", "7", "--teacher", "terminal")
-    for fragment in ("--seed 5 (recorded: 2)", "--task sort-groceries (recorded: pack-lunchbox)",
-                     "--turns 3 (recorded: 4)", "--strategy passive (recorded: all-cd)",
-                     "--kitchen kitchen-2 (recorded: kitchen-1)", "--budget 7.0 (recorded: 10.0)"):
+    for fragment in ("--seed 5 differs from the recorded 2", "--task sort-groceries differs from the recorded "
+                     "pack-lunchbox", "--turns 3 differs from the recorded 4", "--strategy passive differs from "
+                     "the recorded all-cd", "--kitchen kitchen-2 differs from the recorded kitchen-1",
+                     "--budget 7 differs from the recorded 10;"):
         assert fragment in message
+    assert message.endswith("; leave them out, or start a new session without --resume")
     assert "--teacher" not in message  # given, but the default: it can't be told from not given
     assert message.startswith("a resumed session keeps its recorded settings")
+
+
+def test_one_contradicting_number_reads_as_typed(recorded, tmp_path, capsys):
+    """Issue 42, case 7: it read "--budget 10.0 (recorded: 40.0) differ"."""
+    message = refused(tmp_path, capsys, recorded[:3], "--budget", "0.5")
+    assert message == ("a resumed session keeps its recorded settings, but --budget 0.5 differs from the recorded "
+                       "10; leave it out, or start a new session without --resume")
 
 
 def test_options_that_agree_with_the_recorded_session_are_accepted(recorded, tmp_path, capsys):

@@ -1,6 +1,7 @@
 """teachbot train-questioner: a tiny masked-PPO run saves, reloads and plays a policy in regress, demo and teach."""
 
 import json
+import os
 
 import pytest
 
@@ -33,10 +34,14 @@ def test_the_numpy_actor_chooses_what_maskable_ppo_chooses():
 @pytest.fixture(scope="module")
 def trained(tmp_path_factory):
     folder = tmp_path_factory.mktemp("questioner")
-    out = folder / "new-folder" / "q.toml"  # a folder that does not exist yet is created (issue 23, case 1)
-    assert main(["train-questioner", "--out", str(out), "--steps", "256", "--envs", "1", "--seed", "1",
-                 "--no-progress", *TINY]) == 0
-    return out
+    here = os.getcwd()
+    os.chdir(folder)  # a folder that does not exist yet is created inside the current one (issue 23, case 1)
+    try:
+        assert main(["train-questioner", "--out", "new-folder/q.toml", "--steps", "256", "--envs", "1", "--seed",
+                     "1", "--no-progress", *TINY]) == 0
+    finally:
+        os.chdir(here)
+    return folder / "new-folder" / "q.toml"
 
 
 def test_a_tiny_training_run_saves_a_policy_that_reloads(trained, capsys):

@@ -61,8 +61,9 @@ def test_the_summary_counts_questions_in_words_and_the_json_keeps_its_counts(tmp
     assert "; 12 objects a scene (an interactive size; the thesis's experiments use 55);" in lines[-2]
 
 
-def test_default_transcript_names_say_what_differs_from_the_defaults():
+def test_default_transcript_names_say_what_differs_from_the_defaults(tmp_path, monkeypatch):
     """Issue 23 case 11: the embodied demo wrote runs/demo-dt-task-seed0.jsonl over the plain demo's transcript."""
+    monkeypatch.chdir(tmp_path)  # no earlier demo here, so no name is numbered
     from dialog.cli import build_parser
     from dialog.commands.demo import default_transcript
     parse = build_parser().parse_args
@@ -71,3 +72,19 @@ def test_default_transcript_names_say_what_differs_from_the_defaults():
         "runs/demo-dt-task-embodied-600s-seed0.jsonl"
     assert str(default_transcript(parse(["demo", "--task", "prepare-lunch", "--seed", "3"]), None)) == \
         "runs/demo-dt-task-prepare-lunch-seed3.jsonl"
+
+
+def test_an_embodied_demo_is_scored_at_the_allocations_end_and_shows_its_clock(tmp_path, capsys):
+    """Issue 42, case 6: the accuracy came from a turn that ended past --time 60s, and no line showed seconds."""
+    from dialog.cli import main
+
+    path = tmp_path / "e.jsonl"
+    assert main(["demo", "--embodied-costs", "--time", "60s", "--transcript", str(path), "--json"]) == 0
+    out = capsys.readouterr().out
+    records = [json.loads(line) for line in path.read_text().splitlines()][1:]
+    within = [r for r in records if r["ended"] <= 60]
+    assert records[-1]["ended"] > 60 and records[-1]["accuracy"] != within[-1]["accuracy"]  # the crossing turn
+    assert json.loads(out.strip().splitlines()[-1])["accuracy"] == within[-1]["accuracy"]
+    assert f"held-out scenes after 60 s (turn {within[-1]['turn']}, the last that ended within them): " \
+           f"{within[-1]['accuracy']:.1%}" in out
+    assert "Turn   1 at 0.0 s · " in out and f"Turn   2 at {records[1]['time']:.1f} s · " in out
