@@ -14,8 +14,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.linalg import cho_factor, cho_solve, cholesky, solve_triangular
-from scipy.linalg.lapack import spotrf, spotrs, strtrs
+from scipy.linalg import cholesky, solve_triangular
+from scipy.linalg.lapack import dpotrf, dpotrs, spotrf, spotrs, strtrs
 
 
 def rbf_kernel(A: np.ndarray, B: np.ndarray, length_scale: float, variance: float) -> np.ndarray:
@@ -135,10 +135,10 @@ class BinaryGPClassifier:
             W = pi * (1 - pi)
             sw = np.sqrt(W)
             B = np.eye(n) + sw[:, None] * K * sw[None, :]
-            L = cho_factor(B, lower=True)
+            L = dense_factor(B)
             grad = (t + 1) / 2 - pi
             b = W * f + grad
-            a = b - sw * cho_solve(L, sw * (K @ b))
+            a = b - sw * dense_solve(L, sw * (K @ b))
             f_new = K @ a
             if np.max(np.abs(f_new - f)) < self.tolerance:
                 f = f_new
@@ -233,6 +233,23 @@ def mode_factor(K: np.ndarray, sw: np.ndarray) -> tuple[np.ndarray, bool]:
     if info != 0:
         raise np.linalg.LinAlgError(f"I + S K S is not positive definite (LAPACK spotrf info {info})")
     return factor, True
+
+
+def dense_factor(B: np.ndarray) -> np.ndarray:
+    """The lower Cholesky factor of B (float64) by the LAPACK call ``scipy.linalg.cho_factor(B, lower=True)``
+    makes (dpotrf, same arguments, so the same bits), without its wrapper's checks and batching."""
+    factor, info = dpotrf(B, lower=1, clean=0)
+    if info != 0:
+        raise np.linalg.LinAlgError(f"B is not positive definite (LAPACK dpotrf info {info})")
+    return factor
+
+
+def dense_solve(factor: np.ndarray, right: np.ndarray) -> np.ndarray:
+    """B^-1 right from ``dense_factor``'s factor: ``scipy.linalg.cho_solve``'s LAPACK call (dpotrs)."""
+    solved, info = dpotrs(factor, right, lower=1)
+    if info != 0:
+        raise np.linalg.LinAlgError(f"Cholesky solve failed (LAPACK dpotrs info {info})")
+    return solved
 
 
 def factor_solve(factor: np.ndarray, right: np.ndarray) -> np.ndarray:

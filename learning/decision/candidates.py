@@ -76,7 +76,11 @@ def candidate_actions(state) -> tuple[Action, ...]:
     queries += [LabelQuery(i) for i in range(n_objects) if i not in labelled]
     if not state.feature_query_asked:
         queries.append(FeatureQuery())
-    return tuple(a for a in queries if state.can_afford(a)) + (NoQuery(),)
+    affordable: dict[str, bool] = {}  # a query's cost is its kind's: ask the budget once per kind
+    for action in queries:
+        if action.kind not in affordable:
+            affordable[action.kind] = state.can_afford(action)
+    return tuple(a for a in queries if affordable[a.kind]) + (NoQuery(),)
 
 
 def expected_decision_features(state, engine: str | WhatIfEngine = "fast", window_factor: float = 1.0,
