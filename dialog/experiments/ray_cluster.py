@@ -59,12 +59,12 @@ class LoopbackCluster:
 
     def pids(self) -> set[int]:
         """Every running process of the cluster (the nodes and all they started)."""
-        return _descendants({node.pid for node in self.nodes if node.poll() is None})
+        return descendants({node.pid for node in self.nodes if node.poll() is None})
 
     def pids_of(self, index: int) -> dict[int, bytes]:
         """The running processes of node ``index`` (its ``ray start`` and all it started), with their names."""
         node = self.nodes[index]
-        return {pid: _name(pid) for pid in _descendants({node.pid} if node.poll() is None else set())}
+        return {pid: _name(pid) for pid in descendants({node.pid} if node.poll() is None else set())}
 
 
 def token_environment(token: str) -> dict[str, str]:
@@ -176,7 +176,7 @@ def _signal_group(pid: int, signum: int) -> None:
         pass
 
 
-def _descendants(roots: set[int]) -> set[int]:
+def descendants(roots: set[int]) -> set[int]:
     """``roots`` and every process below them (read from /proc)."""
     parents = {}
     for entry in Path("/proc").iterdir():

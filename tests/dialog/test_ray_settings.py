@@ -6,11 +6,11 @@ import signal
 import subprocess
 import sys
 import types
-from pathlib import Path
 
 import pytest
 
 from dialog.experiments import runner
+from dialog.experiments.ray_cluster import descendants
 
 
 class FakeRay:
@@ -69,22 +69,6 @@ def test_a_named_cluster_is_announced_as_trusted_with_code_and_pickles(monkeypat
     assert fake.calls[0]["options"]["address"] == "ray://cluster.example:10001"
 
 
-def descendants(root: int) -> set[int]:
-    parents = {}
-    for entry in Path("/proc").iterdir():
-        if entry.name.isdigit():
-            try:
-                parents[int(entry.name)] = int((entry / "stat").read_text().rsplit(")", 1)[1].split()[1])
-            except (OSError, IndexError, ValueError):
-                continue
-    found, grown = {root}, True
-    while grown:
-        new = {pid for pid, parent in parents.items() if parent in found} - found
-        found |= new
-        grown = bool(new)
-    return found - {root}
-
-
 def listening_sockets(pids: set[int]) -> list[tuple[str, str]]:
     """(local address, process name) of every listening TCP socket the processes own (``ss -ltnp``)."""
     table = subprocess.run(["ss", "-ltnpH"], capture_output=True, text=True, check=True).stdout
@@ -112,7 +96,7 @@ def test_a_local_ray_instance_listens_on_loopback_only():
 
         assert get_authentication_mode() == AuthenticationMode.TOKEN
         assert ray.get(ray.remote(lambda: 41 + 1).remote()) == 42  # a worker is up and listening too
-        sockets = listening_sockets(descendants(os.getpid()) | {os.getpid()})
+        sockets = listening_sockets(descendants({os.getpid()}))
         names = {name for _, name in sockets}
         assert {"gcs_server", "raylet"} <= names, sockets
         loopback = ("127.0.0.1:", "[::ffff:127.0.0.1]:", "[::1]:")
