@@ -5,7 +5,12 @@ the objects. A flat, evenly coloured plane under a directional light has one
 shaded colour and a depth given by a ray-plane intersection, so the camera can
 take it out of the render and paint it back analytically (same colour model,
 same depth, same segmentation id): the objects and the arm are still really
-rendered, and the frame costs a fraction of the time.
+rendered, and the frame costs a fraction of the time. The same goes for what
+lies under the worktop (base cabinets, fixture fronts: hidden from above by the
+worktop) and for the floor around it, painted flat in its colour beyond the
+depth sensor's range. Furniture on and above the worktop is rendered; like the
+painted planes it carries no sensor noise (``scenery``), so the noise drawn on
+the objects and the arm does not depend on the room.
 """
 
 from __future__ import annotations
@@ -18,6 +23,7 @@ import pybullet as p
 DEPTH_NOISE_M_AT_1M = 0.0004   # depth noise standard deviation grows with the square of the distance
 RGB_NOISE = 2.0                # colour noise standard deviation, in 0..255 units
 SPECULAR = 0.05
+UNDER_TOP_DEPTH = 2e-4         # depth-buffer margin (about 0.5 mm at the counter) for "under the worktop"
 HIDDEN_Z = -50.0               # where the backdrop body waits while a frame renders
 
 
@@ -66,6 +72,28 @@ class Backdrop:
     half_size: tuple[float, float]
     top_z: float
     colour: tuple[float, float, float]
+    hidden: tuple[int, ...] = ()        # more bodies under the worktop, taken out of the render with it
+    floor: tuple[int, tuple[float, float, float]] | None = None  # (body, colour) painted where nothing else is
+    scenery: tuple[int, ...] = ()       # rendered furniture: no sensor noise on its pixels
+    decals: tuple[Decal, ...] = ()      # flat pieces lying on the top, painted with it (in this order)
+
+
+@dataclass(frozen=True)
+class Decal:
+    """A flat piece lying on the backdrop's top (a fixture's top, a burner ring, a sink): a box's footprint
+    (``half`` its half sizes) or a cylinder's disc (``half[0]`` its radius), painted in its own colour."""
+
+    body: int
+    shape: str
+    centre: tuple[float, float]
+    half: tuple[float, float]
+    colour: tuple[float, float, float]
+
+    def covers(self, xy: np.ndarray) -> np.ndarray:
+        offset = xy - np.asarray(self.centre)
+        if self.shape == "cylinder":
+            return np.hypot(offset[:, 0], offset[:, 1]) <= self.half[0]
+        return (np.abs(offset[:, 0]) <= self.half[0]) & (np.abs(offset[:, 1]) <= self.half[1])
 
 
 class Camera:
@@ -77,7 +105,8 @@ class Camera:
         self._view = p.computeViewMatrix(list(eye), list(target), list(up))
         self._projection = p.computeProjectionMatrixFOV(fov_degrees, width / height, near, far)
         self.backdrop: Backdrop | None = None
-        self._plane: tuple[np.ndarray, np.ndarray, Backdrop] | None = None
+        self._plane: tuple[np.ndarray, np.ndarray, Backdrop, np.ndarray, np.ndarray] | None = None
+        self._painted: tuple[tuple[float, ...], np.ndarray] | None = None
 
     @classmethod
     def from_config(cls, config: dict) -> Camera:
@@ -97,8 +126,10 @@ class Camera:
             self._plane = None
         self.backdrop = backdrop
 
-    def _backdrop_plane(self) -> tuple[np.ndarray, np.ndarray]:
-        """Which pixels see the backdrop's top, and the depth-buffer value there (computed once)."""
+    def _backdrop_plane(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Which pixels see the backdrop's top, the depth-buffer value there, and the colour (H, W, 3) and
+        body id (H, W) painted on every pixel: the top's or a decal's on the top, the floor's elsewhere (-1 and
+        no colour without a floor). Computed once per backdrop."""
         if self._plane is None or self._plane[2] != self.backdrop:
             backdrop = self.backdrop
             rows, cols = np.mgrid[0:self.height, 0:self.width]
@@ -113,24 +144,42 @@ class Camera:
                      (np.abs(hit[:, 1] - backdrop.centre[1]) <= backdrop.half_size[1]) & (t > 0)
             projected = self.projection_matrix @ self.view_matrix @ np.c_[hit, np.ones(len(hit))].T
             depth = (((projected[2] / projected[3]) + 1.0) / 2.0).astype(np.float32)
-            self._plane = (on_top.reshape(self.height, self.width), depth.reshape(self.height, self.width), backdrop)
-        return self._plane[0], self._plane[1]
+            floor_body, floor_colour = backdrop.floor if backdrop.floor is not None else (-1, (0.0, 0.0, 0.0))
+            colours = np.tile(np.asarray(floor_colour, dtype=np.float32), (len(hit), 1))
+            bodies = np.full(len(hit), floor_body, dtype=np.int32)
+            colours[on_top], bodies[on_top] = backdrop.colour, backdrop.body
+            for decal in backdrop.decals:
+                covered = on_top & decal.covers(hit[:, :2])
+                colours[covered], bodies[covered] = decal.colour, decal.body
+            shape = (self.height, self.width)
+            self._plane = (on_top.reshape(shape), depth.reshape(shape), backdrop, colours.reshape(*shape, 3),
+                           bodies.reshape(shape))
+            self._painted = None
+        return self._plane[0], self._plane[1], self._plane[3], self._plane[4]
 
     def _paint_backdrop(self, rgb, depth, seg, lighting: Lighting) -> None:
-        on_top, plane_depth = self._backdrop_plane()
-        paint = on_top & (seg < 0)
-        shade = np.asarray(self.backdrop.colour) * lighting.plane_shade() * np.asarray(lighting.colour)
-        np.copyto(rgb, np.clip(shade * 255.0, 0, 255).astype(np.uint8), where=paint[..., None])
-        np.copyto(depth, plane_depth, where=paint)
-        np.copyto(seg, np.int32(self.backdrop.body), where=paint)
+        """Paint the top (and its decals) where nothing was rendered above it, and the floor (beyond the far
+        plane: colour only, depth stays 1) where nothing was rendered at all."""
+        on_top, plane_depth, colours, bodies = self._backdrop_plane()
+        factor = lighting.plane_shade() * np.asarray(lighting.colour, dtype=np.float32)
+        key = tuple(float(v) for v in factor)
+        if self._painted is None or self._painted[0] != key:   # one shading per lighting condition
+            self._painted = (key, np.clip(colours * factor * 255.0, 0, 255).astype(np.uint8))
+        under = on_top & ((seg < 0) | (depth > plane_depth + UNDER_TOP_DEPTH))  # what is under the top is hidden
+        paint = under | ((seg < 0) & (bodies >= 0))
+        np.copyto(rgb, self._painted[1], where=paint[..., None])
+        np.copyto(seg, bodies, where=paint)
+        np.copyto(depth, plane_depth, where=under)
 
     def render(self, client: int, lighting: Lighting, rng: np.random.Generator | None = None) -> CameraImages:
         """Render colour, depth and segmentation with the TinyRenderer; add sensor noise when ``rng`` is given."""
-        hidden = None
+        hidden = {}
         if self.backdrop is not None:
-            hidden = p.getBasePositionAndOrientation(self.backdrop.body, physicsClientId=client)
-            p.resetBasePositionAndOrientation(self.backdrop.body, [0, 0, HIDDEN_Z], hidden[1],
-                                              physicsClientId=client)
+            floor = () if self.backdrop.floor is None else (self.backdrop.floor[0],)
+            decals = tuple(decal.body for decal in self.backdrop.decals)
+            for body in (self.backdrop.body, *self.backdrop.hidden, *floor, *decals):
+                hidden[body] = p.getBasePositionAndOrientation(body, physicsClientId=client)
+                p.resetBasePositionAndOrientation(body, [0, 0, HIDDEN_Z], hidden[body][1], physicsClientId=client)
         try:
             _, _, rgba, depth, seg = p.getCameraImage(
                 self.width, self.height, self._view, self._projection,
@@ -139,8 +188,8 @@ class Camera:
                 lightDiffuseCoeff=lighting.diffuse, lightSpecularCoeff=SPECULAR, shadow=0, physicsClientId=client,
             )
         finally:
-            if hidden is not None:
-                p.resetBasePositionAndOrientation(self.backdrop.body, hidden[0], hidden[1], physicsClientId=client)
+            for body, pose in hidden.items():
+                p.resetBasePositionAndOrientation(body, pose[0], pose[1], physicsClientId=client)
         rgb = np.ascontiguousarray(np.asarray(rgba, dtype=np.uint8).reshape(self.height, self.width, 4)[:, :, :3])
         depth = np.array(depth, dtype=np.float32).reshape(self.height, self.width)
         seg = np.array(seg, dtype=np.int32).reshape(self.height, self.width)
@@ -153,9 +202,16 @@ class Camera:
 
     def _add_noise(self, rgb: np.ndarray, depth: np.ndarray, seg: np.ndarray, rng: np.random.Generator):
         """Gaussian colour noise, and depth noise whose spread grows with distance squared (structured
-        light), on every pixel that shows an object or the arm (the painted counter stays clean)."""
-        backdrop = self.backdrop.body if self.backdrop is not None else -2
-        foreground = np.flatnonzero((seg.ravel() >= 0) & (seg.ravel() != backdrop))
+        light), on every pixel that shows an object or the arm (the painted counter and the room stay clean)."""
+        clean = [] if self.backdrop is None else [self.backdrop.body, *self.backdrop.scenery,
+                                                  *(decal.body for decal in self.backdrop.decals)]
+        if self.backdrop is not None and self.backdrop.floor is not None:
+            clean.append(self.backdrop.floor[0])
+        flat_seg = seg.ravel()
+        noisy = np.ones(max(int(flat_seg.max()), *clean, 0) + 2, dtype=bool)
+        noisy[0] = False                     # background (-1)
+        noisy[np.asarray(clean, dtype=np.int64) + 1] = False
+        foreground = np.flatnonzero(noisy[flat_seg + 1])
         flat_rgb = rgb.reshape(-1, 3)
         noise = rng.standard_normal((foreground.size, 3), dtype=np.float32) * RGB_NOISE
         flat_rgb[foreground] = np.clip(flat_rgb[foreground] + noise, 0, 255).astype(np.uint8)

@@ -1,12 +1,26 @@
-"""Kitchens: counter, robot base, camera, lighting, ambient noise and semantic locations (``data/kitchens``)."""
+"""Kitchens: counter, robot base, camera, lighting, ambient noise, semantic locations and the room around
+them (``data/kitchens``; the room's format: :mod:`bullet_world.room`, docs/kitchen.md)."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from bullet_world.datafiles import DataFileError, read_toml, resolve
+from bullet_world.room import (
+    FIXTURE_KINDS,
+    FLUSH_M,
+    Fixture,
+    Piece,
+    Room,
+    base_cabinet_pieces,
+    fixture_pieces,
+    furniture_list,
+    read_fixture,
+    read_materials,
+    read_room,
+)
 from learning.datafiles import check_keys, integer, number, numbers, text, value_range
 from learning.datafiles import section as table_section
 
@@ -50,6 +64,32 @@ class Kitchen:
     focus: tuple[float, float] | None = None  # where objects gather (the work area); None: anywhere alike
     focus_spread: float = 0.25           # metres: how tightly objects gather around the focus
     ambient_noise: dict = field(default_factory=dict)
+    room: Room | None = None             # None: a bare counter (no floor, cabinets or fixtures)
+    fixtures: dict[str, Fixture] = field(default_factory=dict)   # location name -> what it is built as
+
+    def lies_on_worktop(self, piece: Piece) -> bool:
+        """A flat piece on the worktop (a fixture's top, a burner, a sink): no thicker than the worktop, its top
+        at most FLUSH_M above it, and its footprint inside the worktop's."""
+        half = np.asarray(self.counter_size[:2]) / 2
+        inside = np.all(np.abs(np.asarray(piece.centre[:2]) - self.counter_centre) + np.asarray(piece.size[:2]) / 2
+                        <= half + 1e-9)
+        return bool(inside and 0.0 < piece.top <= FLUSH_M and piece.top - piece.size[2] >= -self.counter_size[2])
+
+    def room_pieces(self) -> tuple[list[Piece], list[Piece]]:
+        """(pieces under the worktop, pieces on or above it): the floor, base cabinets and fixture fronts
+        (the overhead camera cannot see them past the worktop), then the fixtures' tops and the furniture."""
+        if self.room is None:
+            return [], []
+        half = (self.counter_size[0] / 2, self.counter_size[1] / 2)
+        thickness, floor_z = self.counter_size[2], -self.room.worktop_height
+        under, above = [], []
+        for name, fixture in self.fixtures.items():
+            for piece in fixture_pieces(name, self.locations[name], fixture, self.counter_centre, half, thickness,
+                                        floor_z):
+                (above if piece.top > -thickness else under).append(piece)
+        fronts = list(under)
+        under = base_cabinet_pieces(self.room, self.counter_centre, half, thickness, fronts) + under
+        return under, above + list(self.room.furniture)
 
     @property
     def interest_points(self) -> dict[str, tuple[float, float, float]]:
@@ -86,7 +126,7 @@ class Kitchen:
 def _location(name: str, table, where: str) -> Location:
     if not isinstance(table, dict):
         raise DataFileError(f"{where}: must be a table with 'centre' = [x, y, z] and 'half_size' = [hx, hy]")
-    check_keys(table, where, required=("centre", "half_size"))
+    check_keys(table, where, required=("centre", "half_size"), optional=("fixture", "material", "accent"))
     half = numbers(table, "half_size", where, length=2, above=0.0)
     return Location(name, numbers(table, "centre", where, length=3), half)
 
@@ -149,7 +189,7 @@ def load_kitchen(name_or_path) -> Kitchen:
     table = read_toml(path, "kitchen")
     where = str(path)
     check_keys(table, where, required=("name", "counter", "robot", "object_region", "camera", "lighting", "locations"),
-               optional=("description", "ambient_noise"))
+               optional=("description", "ambient_noise", "materials", "room", "furniture"))
     section = {key: table_section(table, key, where) for key in
                ("counter", "robot", "object_region", "camera", "lighting", "locations")}
     counter, robot = section["counter"], section["robot"]
@@ -174,6 +214,7 @@ def load_kitchen(name_or_path) -> Kitchen:
     if missing:
         raise DataFileError(f"{where} [locations]: every kitchen needs the interest points "
                             f"{', '.join(INTEREST_POINTS)}; missing {', '.join(missing)}")
+    kitchen = _furnish(kitchen, table, where)
     base = np.asarray(kitchen.robot_base[:2])
     for location in kitchen.locations.values():
         distance = float(np.linalg.norm(np.asarray(location.centre[:2]) - base))
@@ -181,3 +222,35 @@ def load_kitchen(name_or_path) -> Kitchen:
             raise DataFileError(f"{where} [locations.{location.name}]: centre is {distance:.2f} m from the robot "
                                 f"base; locations must be within {ARM_REACH_M} m so the arm can reach them")
     return kitchen
+
+
+def _furnish(kitchen: Kitchen, table: dict, where: str) -> Kitchen:
+    """Add the room, furniture and fixtures, and refuse furniture that stands above the worktop where objects
+    may be placed (the arm reaches there and the camera must see every object whole)."""
+    if "room" not in table:
+        for key in ("materials", "furniture"):
+            if key in table:
+                raise DataFileError(f"{where}: '{key}' needs a [room] table (worktop_height, floor, cabinets, doors, "
+                                    f"handles)")
+        for name, entry in table["locations"].items():
+            if "fixture" in entry:
+                raise DataFileError(f"{where} [locations.{name}]: a 'fixture' needs a [room] table")
+        return kitchen
+    materials = read_materials(table_section(table, "materials", where, {}), f"{where} [materials]")
+    room = read_room(table_section(table, "room", where), f"{where} [room]", materials, furniture_list(table, where),
+                     where)
+    fixtures = {}
+    for name, entry in table["locations"].items():
+        fixture = read_fixture(entry, f"{where} [locations.{name}]", materials)
+        if fixture is None:
+            raise DataFileError(f"{where} [locations.{name}]: in a kitchen with a [room] every location is built "
+                                f"as a fixture; add 'fixture' (one of {', '.join(FIXTURE_KINDS)}) and its "
+                                f"'material' and 'accent'")
+        fixtures[name] = fixture
+    for index, piece in enumerate(room.furniture):
+        if piece.top > FLUSH_M and kitchen.in_object_region(piece.footprint_points()).any():
+            raise DataFileError(f"{where} [[furniture]] {index + 1} ('{piece.name}'): it rises "
+                                f"{piece.top:.2f} m above the worktop where objects may be placed "
+                                f"([object_region]); only pieces flush with the worktop (top <= {FLUSH_M} m) may "
+                                f"stand there")
+    return replace(kitchen, room=room, fixtures=fixtures)

@@ -15,7 +15,7 @@ import numpy as np
 import pybullet as p
 
 from bullet_world.bodies import BodyBuilder, PlacedObject, outline
-from bullet_world.camera import Backdrop, Camera, CameraImages, Lighting
+from bullet_world.camera import Backdrop, Camera, CameraImages, Decal, Lighting
 from bullet_world.catalogue import Kitchen, ObjectKind, Task, load_kitchen, load_task
 from bullet_world.features import (
     environment_feature_catalogue,
@@ -26,6 +26,7 @@ from bullet_world.features import (
 )
 from bullet_world.perception import measure_objects
 from bullet_world.placement import Footprint, PlacementError, footprint_rows, place
+from bullet_world.room import Piece
 from bullet_world.scene import Scene, SceneTruth
 from bullet_world.sensors import AmbientNoise, light_reading, weigh
 from learning.errors import SceneError, SettingsError
@@ -80,10 +81,19 @@ class World:
         self.lighting = Lighting(tuple(self.kitchen.lighting["direction"]), 0.65, 0.6,
                                  tuple(self.kitchen.lighting["colour"]))
         self.counter_body = self._build_counter()
+        under, above = self.kitchen.room_pieces()
+        self.furniture: dict[int, str] = {}   # body -> name of every piece of the room (never an object)
+        hidden = [self._build_piece(piece) for piece in under]
+        floor = (hidden.pop(0), self.kitchen.room.floor_colour) if self.kitchen.room is not None else None
+        flat = [piece for piece in above if self.kitchen.lies_on_worktop(piece)]
+        decals = tuple(Decal(self._build_piece(piece), piece.shape, piece.centre[:2],
+                             (piece.size[0] / 2, piece.size[1] / 2), piece.colour)
+                       for piece in sorted(flat, key=lambda piece: piece.top))
+        shown = tuple(self._build_piece(piece) for piece in above if piece not in flat)
         self.camera = Camera.from_config(self.kitchen.camera)
         length, depth, _ = self.kitchen.counter_size
         self.camera.set_backdrop(Backdrop(self.counter_body, self.kitchen.counter_centre, (length / 2, depth / 2),
-                                          0.0, self.kitchen.counter_colour))
+                                          0.0, self.kitchen.counter_colour, tuple(hidden), floor, shown, decals))
         self.scene: Scene | None = None
         self.images: CameraImages | None = None
 
@@ -96,6 +106,23 @@ class World:
         visual = p.createVisualShape(p.GEOM_BOX, halfExtents=half, rgbaColor=[*self.kitchen.counter_colour, 1],
                                      physicsClientId=self.client)
         return p.createMultiBody(0, shape, visual, centre, physicsClientId=self.client)
+
+    def _build_piece(self, piece: Piece) -> int:
+        """A static body for one piece of the room (see :mod:`bullet_world.room`)."""
+        half = [s / 2 for s in piece.size]
+        colour = [*piece.colour, 1.0]
+        if piece.shape == "box":
+            visual = p.createVisualShape(p.GEOM_BOX, halfExtents=half, rgbaColor=colour, physicsClientId=self.client)
+            shape = p.createCollisionShape(p.GEOM_BOX, halfExtents=half, physicsClientId=self.client) \
+                if piece.collision else -1
+        else:
+            visual = p.createVisualShape(p.GEOM_CYLINDER, radius=half[0], length=piece.size[2], rgbaColor=colour,
+                                         physicsClientId=self.client)
+            shape = p.createCollisionShape(p.GEOM_CYLINDER, radius=half[0], height=piece.size[2],
+                                           physicsClientId=self.client) if piece.collision else -1
+        body = p.createMultiBody(0, shape, visual, list(piece.centre), physicsClientId=self.client)
+        self.furniture[body] = piece.name
+        return body
 
     def attach_robot(self, robot: Proprioceptor) -> None:
         """Let the robot's proprioception join every observation's features."""

@@ -216,8 +216,9 @@ class Viewer:
 
     # -- what is drawn besides the bodies -------------------------------------------------
     def _static_nodes(self) -> Frame:
-        """The kitchen's semantic locations: a translucent region and its name."""
+        """The kitchen's semantic locations: their names, and a translucent region where no fixture shows it."""
         locations = getattr(getattr(self.world, "kitchen", None), "locations", None) or {}
+        fixtures = getattr(getattr(self.world, "kitchen", None), "fixtures", None) or {}
         top = float(_counter_box(self.world)[1][2])
         nodes: Frame = {}
         for index, name in enumerate(sorted(locations)):
@@ -225,8 +226,9 @@ class Viewer:
             (cx, cy, cz), (hx, hy) = location.centre, location.half_size
             rgba = (*REGION_RGBA[index % len(REGION_RGBA)], 0.3)
             z = max(top, float(cz)) + 0.002
-            nodes[f"kitchen/locations/{name}"] = ((Look("box", (2 * hx, 2 * hy, 0.003), rgba),),
-                                                 translation(cx, cy, z))
+            if name not in fixtures:
+                nodes[f"kitchen/locations/{name}"] = ((Look("box", (2 * hx, 2 * hy, 0.003), rgba),),
+                                                     translation(cx, cy, z))
             nodes[f"kitchen/location-names/{name}"] = (_text(name, "location", REGION_LABEL_HEIGHT_M),
                                                        translation(cx, cy + hy - 0.02, z + 0.02))
         return nodes

@@ -155,6 +155,9 @@ class WorldReader:
         if body == getattr(self.world, "counter_body", None):
             return "kitchen/counter"
         self._serial += 1
+        furniture = getattr(self.world, "furniture", {}).get(body)
+        if furniture is not None:   # the room: floor, cabinets, fixtures, walls (bullet_world.room)
+            return f"kitchen/{''.join(c if c.isalnum() else '-' for c in furniture)}-{self._serial}"
         if body in self.world.object_bodies:
             return f"objects/o{self._serial}"
         name = p.getBodyInfo(body, physicsClientId=self.client)[1].decode("utf-8", "replace") or "body"

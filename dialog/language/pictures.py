@@ -9,7 +9,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from bullet_world.annotate import outlined_text
+from bullet_world.annotate import centred_origin, draw_regions, outlined_text, text_box
 from dialog.output_paths import writing
 from learning.errors import OutputPathError
 
@@ -31,23 +31,23 @@ def project_points(points, view_matrix, projection_matrix, width: int, height: i
 
 
 def annotate_scene(rgb: np.ndarray, pixels, numbers, highlight: int | None = None,
-                   regions: dict | None = None) -> np.ndarray:
+                   regions: dict | None = None, boxes: dict | None = None) -> np.ndarray:
     """A BGR copy of ``rgb`` with ``numbers[i]`` written (outlined, readable on any colour) at ``pixels[i]``;
-    ``highlight`` (an index) is ringed; ``regions`` (name: corner pixels (4, 2)) are outlined and named."""
+    ``highlight`` (an index) is ringed; ``regions`` (name: corner pixels (4, 2)) are outlined and named where
+    no number is. ``boxes``, when given, receives the numbers' and the names' text boxes."""
     image = cv2.cvtColor(np.ascontiguousarray(rgb, dtype=np.uint8), cv2.COLOR_RGB2BGR)
     height, width = image.shape[:2]
     scale = max(0.45, width / 900.0)
-    for name, corners in (regions or {}).items():
-        corners = np.asarray(corners, dtype=float)
-        cv2.polylines(image, [np.round(corners).astype(np.int32)], True, REGION_BGR, 2, cv2.LINE_AA)
-        (_, text_h), _ = cv2.getTextSize(name, cv2.FONT_HERSHEY_SIMPLEX, 0.6 * scale, 1)
-        top_left = corners.min(axis=0)
-        outlined_text(image, name, (top_left[0] + 4, top_left[1] + text_h + 5), 0.6 * scale, REGION_BGR,
-                      anchor="corner")
+    placed = []
     for index, ((column, row), number) in enumerate(zip(np.asarray(pixels, dtype=float), numbers)):
-        if not (np.isfinite(column) and np.isfinite(row)):
-            continue
-        centre = (int(round(np.clip(column, 0, width - 1))), int(round(np.clip(row, 0, height - 1))))
+        if np.isfinite(column) and np.isfinite(row):
+            centre = (int(round(np.clip(column, 0, width - 1))), int(round(np.clip(row, 0, height - 1))))
+            placed.append((index, str(number), centre))
+    number_boxes = [text_box(text, centred_origin(text, centre, scale, 2), scale, 2) for _, text, centre in placed]
+    region_boxes = draw_regions(image, regions or {}, REGION_BGR, 0.6 * scale, number_boxes)
+    if boxes is not None:
+        boxes.update(numbers=number_boxes, regions=region_boxes)
+    for index, number, centre in placed:
         if index == highlight:
             radius = int(22 * scale / 0.7)
             cv2.circle(image, centre, radius, OUTLINE_BGR, 7, cv2.LINE_AA)
