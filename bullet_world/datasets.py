@@ -29,7 +29,7 @@ from learning.errors import SettingsError
 
 DATASET_VERSION = 1
 GENERATOR_MODULES = ("bodies", "camera", "catalogue", "datafiles", "datasets", "features", "kitchen", "meshes",
-                     "perception", "placement", "scene", "sensors", "textures", "world")
+                     "perception", "placement", "room", "scene", "sensors", "textures", "world")
 
 
 @dataclass(frozen=True)
