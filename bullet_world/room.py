@@ -218,11 +218,12 @@ def base_cabinet_pieces(room: Room, counter_centre, counter_half, thickness: flo
         for side in (-1, 1):
             for i in range(count):
                 along = (start + i * width + 0.004, start + (i + 1) * width - 0.004)
-                door = _front(f"door {axis}{side:+d}{i}", along, axis, side, counter_centre, counter_half, below,
-                              room.door_colour, depth=0.018)
+                label = f"door {'xy'[axis]}{'-+'[side > 0]}{i + 1}"
+                door = _front(label, along, axis, side, counter_centre, counter_half, below, room.door_colour,
+                              depth=0.018)
                 if any(_overlaps(door, front) for front in fronts):
                     continue
-                pieces += [door, _handle(f"handle {axis}{side:+d}{i}", door, axis, side, room.handle_colour)]
+                pieces += [door, _handle(f"{door.name} handle", door, axis, side, room.handle_colour)]
     return pieces
 
 
