@@ -1,7 +1,7 @@
 """Regenerate the pictures of the three kitchens in docs/ (docs/kitchen.md shows them).
 
 For each kitchen: the overhead camera's annotated picture of a seeded scene with the arm
-(``docs/img/kitchens/kitchen-N-camera.png``, as `teachbot world show --png` draws it, halved) and a view of
+(``docs/img/kitchens/kitchen-N-camera.png``, as `teachbot world show --png` draws it, at 3/4 size) and a view of
 the room from the teacher's side rendered by PyBullet's TinyRenderer (``docs/img/kitchens/kitchen-N-room.png``).
 Deterministic: the same seed gives the same pictures.
 
@@ -60,7 +60,7 @@ def main(argv: list[str] | None = None) -> int:
             Arm(world)
             scene = world.new_scene(np.random.default_rng(args.seed))
             camera = annotate(world.images, scene, world.kitchen, scale=2)
-            camera = cv2.resize(camera, None, fx=0.5, fy=0.5, interpolation=cv2.INTER_AREA)
+            camera = cv2.resize(camera, None, fx=0.75, fy=0.75, interpolation=cv2.INTER_AREA)
             for kind, picture in (("camera", camera), ("room", room_view(world))):
                 path = args.out / f"{name}-{kind}.png"
                 write_png(path, picture)
