@@ -43,7 +43,7 @@ from learning.turn import admissible, scene_epoch
 __all__ = ["DialogManager", "EpisodeConfig", "EpisodeResult", "episode_generators", "question_text"]
 
 STREAMS = ("scenes", "test", "strategy", "teacher", "pantry")
-OBSERVER_EVENTS = ("on_scene", "on_question", "on_answer", "on_turn")
+OBSERVER_EVENTS = ("on_scene", "on_decision", "on_question", "on_answer", "on_turn")
 
 
 @dataclass
@@ -214,6 +214,7 @@ class DialogManager:
         if action is None:
             decision = self.strategy.choose(self.state, self.rngs["strategy"])
             action, explanation = decision.action, decision.explanation
+            self._notify("on_decision", decision)
         chosen = action
         action, reason = admissible(self.state, chosen)  # learning.turn: the library's rules
         if action != chosen and is_plugin(self.strategy):  # the user's code is held to the contract, not mended

@@ -20,6 +20,7 @@ import numpy as np
 from bullet_world.catalogue import load_task
 from dialog.experiments.analysis import FindingResult, evaluate_findings, group_results, summarise
 from dialog.experiments.kinds import SuiteRun
+from dialog.experiments.quiet import quiet_cells
 from dialog.experiments.report import _fmt_p, questions_and_demo_share
 from dialog.experiments.suite import Suite
 from learning.significance import PairedComparison
@@ -100,12 +101,13 @@ def _finding_cell(outcome: FindingResult) -> dict:
 def _cell(group: list[dict], summary, suite: Suite) -> dict:
     questions, share = questions_and_demo_share(group, suite)
     return {"mean": float(summary.mean[-1]), "error": float(summary.error[-1]), "episodes": len(group),
-            "questions": questions, "demo_share": share}
+            "questions": questions, "demo_share": share, **quiet_cells(group)}
 
 
 def replication_summary(suite: Suite, runs: dict[int, SuiteRun], pooled: list[FindingResult], command: str) -> dict:
     """The numbers of ``replication.md`` as data: per condition and strategy the accuracy at the condition's
-    last checkpoint (mean ± standard error over episodes), questions and demonstration share, per data seed
+    last checkpoint (mean ± standard error over episodes), questions, demonstration share and the quiet turns
+    with budget left (``quiet.quiet_cells``), per data seed
     and pooled; per finding its test per data seed and pooled."""
     results = [result for run in runs.values() for result in run.data]
     pooled_groups, pooled_summaries = group_results(results), summarise(results, suite)

@@ -10,6 +10,7 @@ import numpy as np
 from bullet_world.catalogue import load_task
 from dialog.experiments.analysis import CheckpointSummary, FindingResult, group_results, pairwise
 from dialog.experiments.episodes import SERIES
+from dialog.experiments.quiet import quiet_table
 from dialog.experiments.suite import Suite
 from learning.significance import PairedComparison
 from learning.strategies import file_label
@@ -125,8 +126,9 @@ def teacher_in_words(teacher: dict) -> str:
 
 def markdown_report(suite: Suite, results: list[dict], summaries: list[CheckpointSummary],
                     findings: list[FindingResult], seconds: float, out: Path, figures: list[Path]) -> Path:
-    """``report.md``: per condition the figures, accuracy at the checkpoints inside its turns, pairwise
-    tests at its last checkpoint; then every finding, tested or skipped with the reason."""
+    """``report.md``: per condition the figures, accuracy at the checkpoints inside its turns, the quiet turns
+    with budget left (``quiet.py``), pairwise tests at its last checkpoint; then every finding, tested or
+    skipped with the reason."""
     axis_name = {"questions": "questions asked", "seconds": "seconds"}.get(suite.axis, "turns")
     lines = [f"# Regression report: {suite.name}", "", suite.description, "",
              f"- task `{suite.task}`, kitchen `{suite.kitchen}`, {suite.datasets} training data sets, "
@@ -172,6 +174,7 @@ def markdown_report(suite: Suite, results: list[dict], summaries: list[Checkpoin
                 turns = np.mean([r["series"]["turn"][-1] for r in group])
                 cells += f" | {turns:.1f} turns, {np.mean([r['series']['seconds'][-1] for r in group]):.0f} s"
             lines.append(f"| {summary.strategy} | {cells} | {questions:.1f} | {demo_cost:.0%} |")
+        lines += ["", *quiet_table(groups, condition.name, [summary.strategy for summary in rows])]
         column = len(checkpoints) - 1
         lines += ["", f"Exploratory (not corrected, not planned): two-sided tests between every pair of strategies "
                       f"after {checkpoints[column]} {axis_name}.", ""]
