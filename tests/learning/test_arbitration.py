@@ -1,6 +1,5 @@
 """All nine strategies in the teaching loop (thesis ch. 6-7), on a simulator-free task."""
 
-
 import numpy as np
 import pytest
 from hypothesis import given, settings
