@@ -3,8 +3,8 @@
 Each data seed is a run of its own (its pools rendered from that seed, its own
 report in ``data-seed-N/``). The pooled test pairs every episode two
 strategies share across all the data seeds (unit: the episode pair; the
-interval resamples the training pools of every data seed, the independent
-units), with Holm's correction over the suite's findings as in one run.
+interval resamples whole data seeds, whose episodes share a test pool), with
+Holm's correction over the suite's findings as in one run.
 ``replication.md`` puts each finding's verdict per data seed beside the pooled one;
 ``replication.json`` holds the same numbers for ``scripts/experiments.py``, which
 writes the docs' tables from it.
@@ -21,7 +21,7 @@ from bullet_world.catalogue import load_task
 from dialog.experiments.analysis import FindingResult, evaluate_findings, group_results, summarise
 from dialog.experiments.kinds import SuiteRun
 from dialog.experiments.quiet import quiet_cells
-from dialog.experiments.report import _fmt_p, questions_and_demo_share
+from dialog.experiments.report import _fmt_p, interval_in_words, questions_and_demo_share
 from dialog.experiments.suite import Suite
 from learning.significance import PairedComparison
 
@@ -48,7 +48,7 @@ def _pooled_cells(outcome: FindingResult) -> str:
     if not paired:
         return "– | –"
     pairs = min(c.n for c in paired)
-    effects = ", ".join(f"{c.b} {c.effect:+.2f} [{c.ci[0]:+.3f}, {c.ci[1]:+.3f}]" for c in paired)
+    effects = ", ".join(f"{c.b} {c.effect:+.2f} {interval_in_words(c)}" for c in paired)
     return f"{pairs} | {effects}"
 
 
@@ -94,7 +94,8 @@ def _finding_cell(outcome: FindingResult) -> dict:
             "p_holm": _worst_holm_p(outcome),
             "pairs": min(getattr(c, "n", 0) for c in outcome.comparisons),
             "comparisons": [{"than": c.b, "mean": c.mean_a, "mean_than": c.mean_b,
-                             "effect_r": getattr(c, "effect", None), "ci": list(getattr(c, "ci", ()))}
+                             "effect_r": getattr(c, "effect", None), "ci": list(getattr(c, "ci", None) or ()),
+                             "clusters": getattr(c, "clusters", None)}
                             for c in outcome.comparisons]}
 
 

@@ -188,6 +188,18 @@ def _episodes_per_cell(conditions: list[dict]) -> str:
     return "/".join(map(str, counts))
 
 
+def _effect_cell(comparison: dict) -> str:
+    """"vs a +0.050 [+0.010, +0.090] (5 clusters), r +0.40": the pooled mean difference, its interval with the
+    number of clusters (data seeds) it resampled where the record has it, and r."""
+    difference = f"vs {comparison['than']} {comparison['mean'] - comparison['mean_than']:+.3f}"
+    if comparison["effect_r"] is None:
+        return difference
+    clusters = comparison.get("clusters")
+    counted = "" if clusters is None else f" ({clusters} cluster{'s' if clusters != 1 else ''})"
+    interval = f" [{comparison['ci'][0]:+.3f}, {comparison['ci'][1]:+.3f}]" if comparison["ci"] else " no interval"
+    return f"{difference}{interval}{counted}, r {comparison['effect_r']:+.2f}"
+
+
 def _seed_cell(cell: dict | None) -> str:
     if not cell or not cell["tested"]:
         return "–"
@@ -212,16 +224,14 @@ def findings_table(replication: dict) -> str:
              "with the largest one-tailed Wilcoxon p of its comparisons (uncorrected; "
              f"{replication['datasets'] * len(replication['seeds'])} pairs a data seed). "
              "Pooled: the same paired tests over every data seed's episodes, Holm-corrected over the suite's "
-             "findings, with each comparison's mean difference, its 95 % cluster-bootstrap interval and the "
-             "rank-biserial r.", "",
+             "findings, with each comparison's mean difference, its 95 % cluster-bootstrap interval (whole data "
+             "seeds resampled, their number beside it) and the rank-biserial r.", "",
              "| finding | " + " | ".join(f"data seed {s}" for s in seeds)
              + " | pooled pairs | pooled effects | Holm p | holds? |", "|---" * (len(seeds) + 5) + "|"]
     for finding in replication["findings"]:
         pooled = finding["pooled"]
         if pooled["tested"]:
-            effects = "; ".join(f"vs {c['than']} {c['mean'] - c['mean_than']:+.3f} [{c['ci'][0]:+.3f}, "
-                                f"{c['ci'][1]:+.3f}], r {c['effect_r']:+.2f}" if c["ci"] and c["effect_r"] is not None
-                                else f"vs {c['than']} {c['mean'] - c['mean_than']:+.3f}" for c in pooled["comparisons"])
+            effects = "; ".join(_effect_cell(c) for c in pooled["comparisons"])
             tail = f"{pooled['pairs']} | {effects} | {format_p(pooled['p_holm'])} | {finding_verdict(pooled)}"
         else:
             tail = f"– | {pooled['why']} | – | not tested"

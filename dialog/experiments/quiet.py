@@ -102,3 +102,10 @@ def quiet_cells(group: list[dict]) -> dict:
     return {"quiet_per_episode": summary.per_episode, "quiet_share": summary.share,
             "quiet_terms": {name: float(np.round(value, 8)) for name, value in summary.terms.items()},
             "quiet_turns_with_terms": summary.with_terms}
+
+
+def quiet_columns(result: dict) -> tuple[int, str]:
+    """One episode's quiet turns with budget left and its mean terms on them ("feature=+0.0067;..."; empty for a
+    strategy without terms), the last two columns of episodes.csv."""
+    summary = summarise_quiet([result])
+    return summary.quiet, ";".join(f"{name}={value:+.6f}" for name, value in summary.terms.items())

@@ -10,20 +10,21 @@ import numpy as np
 from bullet_world.catalogue import load_task
 from dialog.experiments.analysis import CheckpointSummary, FindingResult, group_results, pairwise
 from dialog.experiments.episodes import SERIES
-from dialog.experiments.quiet import quiet_table
+from dialog.experiments.quiet import quiet_columns, quiet_table
 from dialog.experiments.suite import Suite
 from learning.significance import PairedComparison
 from learning.strategies import file_label
 
 
 def write_episode_csvs(results: list[dict], out: Path) -> Path:
-    """One CSV per episode (turn, accuracy, questions by type, budget) and one summary row per episode."""
+    """One CSV per episode (turn, accuracy, questions by type, budget) and one summary row per episode, ending
+    with its quiet turns with budget left and DT's mean terms on them (``quiet.quiet_columns``)."""
     summary_path = out / "episodes.csv"
     out.mkdir(parents=True, exist_ok=True)
     with open(summary_path, "w", newline="") as summary_file:
         summary = csv.writer(summary_file)
         summary.writerow(["condition", "strategy", "dataset", "seed", "accuracy", "questions", "label", "demo",
-                          "feature", "spent", "seconds", "csv"])
+                          "feature", "spent", "seconds", "csv", "quiet_with_budget_left", "quiet_terms"])
         for result in results:
             spec, series = result["spec"], result["series"]
             path = out / "episodes" / spec["condition"]["name"] / f"{file_label(spec['strategy'])}" \
@@ -36,7 +37,7 @@ def write_episode_csvs(results: list[dict], out: Path) -> Path:
             summary.writerow([spec["condition"]["name"], spec["strategy"], spec["dataset"], spec["seed"],
                               f"{result['accuracy']:.4f}", series["questions"][-1], series["label"][-1],
                               series["demo"][-1], series["feature"][-1], series["spent"][-1],
-                              f"{result['seconds']:.2f}", path.relative_to(out)])
+                              f"{result['seconds']:.2f}", path.relative_to(out), *quiet_columns(result)])
     return summary_path
 
 
@@ -54,20 +55,25 @@ def _fmt_p(p: float) -> str:
 
 
 PLANNED_NOTE = ("Every strategy played the same episodes (the same pools, seeds and scenes), so each comparison is "
-                "paired: the Wilcoxon signed-rank test over the shared episodes (n pairs), the matched-pairs "
-                "rank-biserial r, the median difference, and a 95 % interval of the mean difference from a cluster "
-                "bootstrap over the training pools and data seeds (the independent units; episodes of one pool "
-                "share its data). A finding holds when every one of its comparisons is significant after Holm's "
-                "correction over all the comparisons in this table.")
+                "paired: the Wilcoxon signed-rank test over the shared episodes (n pairs, treated as independent), "
+                "the matched-pairs rank-biserial r, the median difference, and a 95 % interval of the mean "
+                "difference from a cluster bootstrap over the data seeds (the episodes of one data seed share its "
+                "rendered data and test pool, so a data seed is one cluster; the number of clusters stands beside "
+                "each interval, and with one data seed there is no interval). A finding holds when every one of "
+                "its comparisons is significant after Holm's correction over all the comparisons in this table.")
 
 
 def _paired_cells(c) -> str:
     """n | median diff | r | CI | W for a paired comparison; the unpaired Mann-Whitney's n and U otherwise."""
     if isinstance(c, PairedComparison):
-        low, high = c.ci
-        return (f"{c.n} | {c.median_difference:+.3f} | {c.effect:+.2f} | [{low:+.3f}, {high:+.3f}] "
-                f"({c.clusters} clusters) | {c.statistic:.1f}")
+        return f"{c.n} | {c.median_difference:+.3f} | {c.effect:+.2f} | {interval_in_words(c)} | {c.statistic:.1f}"
     return f"{c.n_a} + {c.n_b} | – | – | – | U {c.u:.1f}"
+
+
+def interval_in_words(c: PairedComparison) -> str:
+    """"[+0.010, +0.050] (5 clusters)", or "none (1 cluster)" when a single cluster leaves nothing to resample."""
+    clusters = f"({c.clusters} cluster{'s' if c.clusters != 1 else ''})"
+    return f"none {clusters}" if c.ci is None else f"[{c.ci[0]:+.3f}, {c.ci[1]:+.3f}] {clusters}"
 
 
 def comparison_table(comparisons: list, at: str) -> list[str]:
