@@ -65,7 +65,7 @@ class DecisionTheoreticStrategy(CandidateStrategy):
         terms = utility_terms(candidates.expected, self.weights, best, stay, candidates.feature_names)
         reason = _query_reason(state, action, terms)
         if candidates.seconds is not None:  # embodied costs: the gain per expected second chose it
-            reason += (f" Of the questions worth asking it should give the most per second "
+            reason += (f" Of the questions worth asking, it should gain the most per second it takes "
                        f"(about {max(1, round(float(candidates.seconds[best])))} s).")
         return Decision(action, reason, terms)
 
