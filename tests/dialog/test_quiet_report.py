@@ -39,3 +39,25 @@ def test_the_mean_terms_over_the_quiet_turns_say_what_kept_dt_quiet():
         episode([1, 2], [1, 2], [{}, {}], strategy="active")]}, "static", ["dt-iros", "active"])
     assert "| dt-iros | 2.0 | 57% | CDU -0.013, ACD +0.0047; sum -0.0078 (3 turns) |" in lines
     assert "| active | 0.0 | 0% | – |" in lines
+
+
+def test_an_episode_keeps_dts_terms_beside_the_transcript_and_none_for_other_strategies(tmp_path):
+    from dataclasses import replace
+
+    from dialog.experiments.episodes import run_episode
+    from dialog.experiments.fingerprint import fingerprint_episodes
+    from dialog.transcripts.jsonl import read_transcript
+
+    specs = {e.label: e.spec for e in fingerprint_episodes(transcripts=tmp_path)}
+    for label, weighted in (("smoke/dt-task/d0", True), ("smoke/active/d0", False)):
+        spec = replace(specs[label], transcript=str(tmp_path / f"{label.replace('/', '-')}.jsonl"))
+        result = run_episode(spec)
+        terms = result["decision_terms"]
+        assert len(terms) == len(result["series"]["turn"])
+        if weighted:  # a term per weighted feature on every turn DT chose from candidates
+            assert sum(bool(t) for t in terms) > len(terms) // 2
+            assert all(set(t) <= {"classifier_discriminability", "class_distribution_uniformity",
+                                  "instance_variation", "prediction_margin"} for t in terms)
+        else:
+            assert not any(terms)
+        assert all("terms" not in record for record in read_transcript(spec.transcript))
