@@ -20,7 +20,7 @@ import numpy as np
 from bullet_world.catalogue import load_task
 from dialog.experiments.analysis import FindingResult, evaluate_findings, group_results, summarise
 from dialog.experiments.kinds import SuiteRun
-from dialog.experiments.quiet import quiet_cells
+from dialog.experiments.quiet import quiet_cells, quiet_table
 from dialog.experiments.report import _fmt_p, interval_in_words, questions_and_demo_share
 from dialog.experiments.suite import Suite
 from learning.significance import PairedComparison
@@ -54,7 +54,8 @@ def _pooled_cells(outcome: FindingResult) -> str:
 
 def replication_report(suite: Suite, runs: dict[int, SuiteRun], pooled: list[FindingResult], out: Path,
                        command: str) -> Path:
-    """``replication.md``: every finding's verdict on each data seed and pooled over all of them."""
+    """``replication.md``: every finding's verdict on each data seed and pooled over all of them; per condition
+    the quiet turns with budget left, pooled."""
     seeds = sorted(runs)
     episodes = sum(run.count for run in runs.values())
     lines = [f"# Replication of `{suite.name}` on data seeds {', '.join(map(str, seeds))}", "",
@@ -62,8 +63,8 @@ def replication_report(suite: Suite, runs: dict[int, SuiteRun], pooled: list[Fin
              "data seed's own report is in `data-seed-N/report.md`.", "",
              "Per data seed: the paired tests of that run, Holm-corrected over its findings. Pooled: the same "
              "tests over the episode pairs of every data seed (the unit of the test is one episode pair; the "
-             "interval is a cluster bootstrap over the training pools of all data seeds), Holm-corrected over "
-             "the findings.", "",
+             "interval is a cluster bootstrap over the data seeds, whose episodes share a test pool, with the "
+             "number of clusters beside it), Holm-corrected over the findings.", "",
              "| finding | " + " | ".join(f"data seed {s}" for s in seeds) + " | pooled | pooled pairs | "
              "pooled effect r [95 % CI of the mean difference] per comparison |",
              "|---" * (len(seeds) + 4) + "|"]
@@ -73,6 +74,11 @@ def replication_report(suite: Suite, runs: dict[int, SuiteRun], pooled: list[Fin
                  for s in seeds]
         lines.append(f"| {outcome.finding.id}: {outcome.finding.text} | " + " | ".join(cells)
                      + f" | {_verdict(outcome)} | {_pooled_cells(outcome)} |")
+    groups = group_results([result for run in runs.values() for result in run.data])
+    for condition in suite.conditions:
+        strategies = [strategy for (name, strategy) in groups if name == condition.name]
+        lines += ["", f"## Condition `{condition.name}`, pooled over the data seeds", "",
+                  *quiet_table(groups, condition.name, strategies)]
     path = out / "replication.md"
     path.write_text("\n".join(lines) + "\n", encoding="utf-8")
     return path
