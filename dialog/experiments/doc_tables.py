@@ -189,9 +189,8 @@ def results_table(replication: dict) -> str:
 
 
 def _turns_cell(pooled: dict) -> str:
-    """", 155 / 140 turns, 2 at the bound" for a condition that runs until its budget is spent."""
-    bound = f", {pooled['at_bound']} at the bound" if pooled.get("at_bound") else ""
-    return f", {pooled['turns_mean']:.0f} / {pooled['turns_median']:g} turns{bound}"
+    """, 155 / 140 turns, 2 at the bound" for a condition that runs until its budget is spent."""
+    return f", {pooled['turns_mean']:.0f} / {pooled['turns_median']:g} turns, {pooled['at_bound']} at the bound"
 
 
 def _episodes_per_cell(conditions: list[dict]) -> str:

@@ -188,8 +188,8 @@ def markdown_report(suite: Suite, results: list[dict], summaries: list[Checkpoin
                 cells += f" | {turns:.1f} turns, {np.mean([r['series']['seconds'][-1] for r in group]):.0f} s"
             elif condition.until_budget_spent:  # the thesis's ending: turns taken (mean / median), at the bound
                 taken = turns_used(group)
-                cells += f" | {taken['turns_mean']:.1f} / {taken['turns_median']:g} turns"
-                cells += f", {taken['at_bound']} of {len(group)} at the bound" if taken["at_bound"] else ""
+                cells += f" | {taken['turns_mean']:.1f} / {taken['turns_median']:g} turns, {taken['at_bound']} of " \
+                         f"{len(group)} at the bound"
             lines.append(f"| {summary.strategy} | {cells} | {questions:.1f} | {demo_cost:.0%} |")
         if condition.until_budget_spent:
             lines += ["", f"Episodes run until the budget is spent; \"used\" gives the turns they took (mean / "

@@ -81,3 +81,22 @@ def test_a_bad_until_budget_spent_is_one_message(tmp_path):
                     'budget = 4\nturns = 40\nchange_every = 5\nuntil_budget_spent = "yes"\n')
     with pytest.raises(SuiteError, match="'until_budget_spent' must be true or false"):
         load_suite(path)
+
+
+def test_the_docs_table_gives_turns_used_and_the_bound_count_where_the_budget_ends_the_episode():
+    from dialog.experiments.doc_tables import results_table
+
+    def row(strategy, at_bound):
+        pooled = {"mean": 0.8, "error": 0.01, "episodes": 5, "questions": 40.0, "demo_share": 0.5,
+                  "turns_mean": 155.0, "turns_median": 140.0, "at_bound": at_bound}
+        return {"strategy": strategy, "at": 40, "pooled": pooled}
+
+    condition = {"name": "static", "budget": 40, "turns": 400, "seconds": None, "change_every": 5,
+                 "objects_per_scene": 55, "teacher": {}, "until_budget_spent": True}
+    capped = condition | {"name": "static-capped", "turns": 120, "until_budget_spent": False}
+    table = results_table({"conditions": [condition | {"strategies": [row("dt-iros", 2)]},
+                                          capped | {"strategies": [row("dt-iros", 0)]}],
+                           "axis": "questions", "data_seeds": [0], "datasets": 5, "seeds": [0]})
+    assert "`static`: budget 40, until the budget is spent (bound 400 turns)" in table
+    assert "`static-capped`: budget 40, 120 turns" in table
+    assert "| dt-iros | 40.0 q, 50%, 155 / 140 turns, 2 at the bound | 40.0 q, 50% |" in table
