@@ -183,9 +183,11 @@ def calibrate(rule: Rule, results_dir: Path, workers: int | None = None, progres
     by_condition: dict[str, list[float]] = {}  # "suite/condition": each episode's seconds (one core)
     for suite in plan_suites(rule):
         say(f"{suite.name}, data seed {suite.data_seed}: rendering or reading the data sets")
+        rendering = time.perf_counter()
         load_pools(suite.task, suite.kitchen, suite.datasets, suite.plan_options, data_seed=suite.data_seed)
         specs = episode_specs(suite, results_dir / suite.name / f"data-seed-{suite.data_seed}")
-        say(f"{suite.name}, data seed {suite.data_seed}: {len(specs)} episodes")
+        say(f"{suite.name}, data seed {suite.data_seed}: data sets ready in {time.perf_counter() - rendering:.0f} s; "
+            f"{len(specs)} episodes")
         for result in run_locally(specs, workers, progress):
             finals.setdefault(result["spec"]["strategy"], []).append(float(result["accuracy"]))
             by_condition.setdefault(f"{suite.name}/{result['spec']['condition']['name']}", []).append(
