@@ -95,3 +95,14 @@ def test_the_script_prints_the_plan_and_an_estimate_without_playing(tmp_path, ca
     facts = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
     assert facts["episodes"] == load_rule(RULE_FILE).episodes and facts["rule_sha256"] == load_rule().sha256
     assert facts["estimated_seconds"] is None or facts["estimated_seconds"] > 0
+
+
+def test_a_missing_rule_or_a_bad_cost_file_is_one_message(tmp_path):
+    script = load_script("calibrate_dt")
+    with pytest.raises(DataFileError, match="no calibration rule file there"):
+        script.main(script._parse(["--rule", str(tmp_path / "none.toml"), "--dry-run"]))
+    cost = tmp_path / "cost.toml"
+    cost.write_text('[[measured]]\ncondition = "ch6-static/static"\nseconds_per_episode = -1\n')
+    with pytest.raises(DataFileError, match="seconds_per_episode"):
+        script.seconds_per_episode(cost)
+    assert script.seconds_per_episode()["ch6-static/static"] > 0  # the committed measurement
