@@ -91,6 +91,8 @@ class EpisodeSettings:
                 raise SettingsError(f"{name} must be true or false, got {getattr(self, name)!r}")
         check_costs(self.costs)
         check_questions(self.turns, self.budget, self.costs)
+        if self.until_budget_spent:
+            check_budget_pays_for_a_question(self.budget, self.costs)
         if self.weights is not None:
             weights_from_record(self.weights)
 
@@ -106,6 +108,16 @@ class EpisodeSettings:
                              costs=dict(self.costs), realtime=self.realtime, pictures=pictures,
                              fetch_from_pantry=self.fetch_from_pantry, seconds=self.seconds,
                              until_budget_spent=self.until_budget_spent)
+
+
+def check_budget_pays_for_a_question(budget: float, costs: dict) -> None:
+    """An episode that ends once its budget is spent needs a budget that pays for some question at the start,
+    else it would end before its first turn (SettingsError naming the cheapest question)."""
+    cheapest = min(float(costs[kind]) for kind in ("label", "demo", "feature"))
+    if cheapest > budget + 1e-9:
+        raise SettingsError(f"until_budget_spent: a budget of {budget:g} pays for no question (the cheapest costs "
+                            f"{cheapest:g}), so the episode would end before its first turn; give a budget of at "
+                            f"least {cheapest:g}")
 
 
 def _is_int(value) -> bool:

@@ -11,6 +11,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from dialog.experiments.registry import kind_names
+from dialog.settings import check_budget_pays_for_a_question
 from learning import datafiles
 from learning.actions import DEFAULT_COSTS
 from learning.datafiles import check_keys, flag, integer, number, numbers, read_toml, section, tables, text, texts
@@ -200,6 +201,12 @@ def _suite(table: dict, where: str, known_strategies) -> Suite:
         raise SuiteError(f"{where}: condition names must be unique, got {names}")
     if kind == "recipes" and "data_seed" in table:
         raise SuiteError(f"{where}: 'data_seed' is not accepted in a suite of kind 'recipes' (it renders no data sets)")
+    costs = _costs(table, where)
+    for condition in (c for c in conditions if c.until_budget_spent):
+        try:
+            check_budget_pays_for_a_question(condition.budget, costs or DEFAULT_COSTS)
+        except SettingsError as error:
+            raise SuiteError(f"{where} condition '{condition.name}': {error}") from None
     findings = tuple(_finding(f, kind, strategies, names, f"{where} finding {i + 1}")
                      for i, f in enumerate(tables(table, "finding", where, [])))
     seeds = numbers(table, "seeds", where, (0,), whole=True, low=0)
@@ -213,7 +220,7 @@ def _suite(table: dict, where: str, known_strategies) -> Suite:
         strategies=strategies, conditions=conditions,
         datasets=integer(table, "datasets", where, 5, low=1, high=maximum("datasets")),
         seeds=seeds, checkpoints=checkpoints,
-        axis=text(table, "axis", where, "questions", choices=AXES), costs=_costs(table, where),
+        axis=text(table, "axis", where, "questions", choices=AXES), costs=costs,
         teacher=_teacher(table, where), findings=findings, options=_options(table, kind, where), path=where,
         dataset=_plan(table, where), analysis=text(table, "analysis", where, "", nonempty=False),
         data_seed=integer(table, "data_seed", where, 0, low=0),

@@ -100,3 +100,16 @@ def test_the_docs_table_gives_turns_used_and_the_bound_count_where_the_budget_en
     assert "`static`: budget 40, until the budget is spent (bound 400 turns)" in table
     assert "`static-capped`: budget 40, 120 turns" in table
     assert "| dt-iros | 40.0 q, 50%, 155 / 140 turns, 2 at the bound | 40.0 q, 50% |" in table
+
+
+def test_a_budget_that_pays_for_no_question_is_refused_before_any_turn(tmp_path):
+    from dialog.settings import EpisodeSettings
+    from learning.errors import SettingsError
+    with pytest.raises(SettingsError, match="pays for no question"):
+        EpisodeSettings(budget=0.5, costs=COSTS, until_budget_spent=True)
+    EpisodeSettings(budget=0.5, costs=COSTS)  # a capped episode may stay quiet for its turns
+    path = tmp_path / "poor.toml"
+    path.write_text('name = "poor"\nstrategies = ["active"]\ncheckpoints = [1]\n[[condition]]\nname = "c"\n'
+                    'budget = 0\nturns = 40\nchange_every = 5\nuntil_budget_spent = true\n')
+    with pytest.raises(SuiteError, match="condition 'c': until_budget_spent: a budget of 0 pays for no question"):
+        load_suite(path)
