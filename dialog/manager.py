@@ -38,7 +38,7 @@ from learning.state import LearningState
 from learning.strategies import Strategy
 from learning.strategies.check import refuse_invalid_decision
 from learning.strategies.plugins import is_plugin
-from learning.turn import admissible, scene_epoch
+from learning.turn import admissible, budget_spent, scene_epoch
 
 __all__ = ["DialogManager", "EpisodeConfig", "EpisodeResult", "episode_generators", "question_text"]
 
@@ -62,6 +62,9 @@ class EpisodeResult:
     #: turns that is (the turn in progress when the seconds ran out does not count, docs/experiments.md)
     allocation_accuracy: float | None = None
     allocation_turns: int = 0
+    #: why the episode ended: "budget" (spent, the chapter-6 ending), "bound" (the turns ran out while ending
+    #: on the budget), "turns" (the allocation's turns), "seconds" (embodied costs) or "quit"
+    ended: str = "turns"
 
 
 def episode_generators(seed: int) -> dict[str, np.random.Generator]:
@@ -119,6 +122,7 @@ class DialogManager:
                 "fetch_from_pantry": config.fetch_from_pantry, "strategy": self.strategy.name,
                 "concepts": list(self.env.concepts), "features": len(self.env.feature_names),
                 **getattr(self.strategy, "header_fields", dict)(), **self.session,
+                **({"until_budget_spent": True} if config.until_budget_spent else {}),
                 **({} if self.embodied is None else {"seconds": config.seconds,
                                                      "embodied_costs": self.embodied.record()})}
 
@@ -135,6 +139,8 @@ class DialogManager:
         self.begin()
         replay = list(replay)
         while self.turn < self.config.turns and not self.quit:
+            if self.config.until_budget_spent and budget_spent(self.state):
+                break
             if self.turn < len(replay):
                 self.replay_turn(replay[self.turn])
             elif self.out_of_time():
@@ -153,7 +159,16 @@ class DialogManager:
             accuracy=self.test_accuracy(), transcript=str(self.transcript.path),
             seconds=seconds, completed=self.turn, quit=self.quit,
             allocation_accuracy=self._within_allocation[0], allocation_turns=self._within_allocation[1],
+            ended=self.ending(),
         )
+
+    def ending(self) -> str:
+        """Why the episode ended, or would end now (``EpisodeResult.ended``)."""
+        if self.quit:
+            return "quit"
+        if self.config.until_budget_spent:
+            return "budget" if budget_spent(self.state) else "bound"
+        return "seconds" if self.out_of_time() else "turns"
 
     # -- the clock and the world ---------------------------------------------------
     def out_of_time(self) -> bool:

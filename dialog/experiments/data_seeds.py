@@ -21,7 +21,7 @@ from bullet_world.catalogue import load_task
 from dialog.experiments.analysis import FindingResult, evaluate_findings, group_results, summarise
 from dialog.experiments.kinds import SuiteRun
 from dialog.experiments.quiet import quiet_cells, quiet_table
-from dialog.experiments.report import _fmt_p, interval_in_words, questions_and_demo_share
+from dialog.experiments.report import _fmt_p, interval_in_words, questions_and_demo_share, turns_used
 from dialog.experiments.suite import Suite
 from learning.significance import PairedComparison
 
@@ -108,7 +108,7 @@ def _finding_cell(outcome: FindingResult) -> dict:
 def _cell(group: list[dict], summary, suite: Suite) -> dict:
     questions, share = questions_and_demo_share(group, suite)
     return {"mean": float(summary.mean[-1]), "error": float(summary.error[-1]), "episodes": len(group),
-            "questions": questions, "demo_share": share, **quiet_cells(group)}
+            "questions": questions, "demo_share": share, **quiet_cells(group), **turns_used(group)}
 
 
 def replication_summary(suite: Suite, runs: dict[int, SuiteRun], pooled: list[FindingResult], command: str) -> dict:
@@ -135,6 +135,7 @@ def replication_summary(suite: Suite, runs: dict[int, SuiteRun], pooled: list[Fi
             rows.append(row)
         conditions.append({"name": condition.name, "budget": condition.budget, "turns": condition.turns,
                            "seconds": condition.seconds, "change_every": condition.change_every,
+                           "until_budget_spent": condition.until_budget_spent,
                            "objects_per_scene": condition.scene_size(scene_default),
                            "teacher": dict(condition.teacher), "strategies": rows})
     by_seed = {seed: {o.finding.id: o for o in run.findings} for seed, run in runs.items()}

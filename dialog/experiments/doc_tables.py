@@ -149,6 +149,8 @@ def _comment_just_above(lines: list[str], header_index: int, allowed: str) -> bo
 
 def _condition_line(condition: dict, at: int | None, axis: str) -> str:
     limit = f"{condition['seconds']:g} s" if condition.get("seconds") else f"{condition['turns']} turns"
+    if condition.get("until_budget_spent"):
+        limit = f"until the budget is spent (bound {condition['turns']} turns)"
     teacher = {k: v for k, v in condition.get("teacher", {}).items() if k != "kind"}
     told = (", teacher " + ", ".join(f"{k.replace('_', ' ')} {v}" for k, v in sorted(teacher.items()))) if teacher \
         else ""
@@ -174,13 +176,21 @@ def results_table(replication: dict) -> str:
         cells = [f"{r['pooled']['mean']:.3f} ± {r['pooled']['error']:.3f}" if (r := cell.get((c["name"], strategy)))
                  else "–" for c in conditions]
         lines.append(f"| {strategy} | " + " | ".join(cells) + " |")
-    lines += ["", "Questions asked (mean) and the share of the spent budget that went on demonstrations:", "",
+    lines += ["", "Questions asked (mean) and the share of the spent budget that went on demonstrations; where a "
+                  "condition runs until the budget is spent, the turns taken (mean / median) and how many episodes "
+                  "reached the bound:", "",
               "| strategy | " + " | ".join(c["name"] for c in conditions) + " |", "|---" * (len(conditions) + 1) + "|"]
     for strategy in strategies:
         cells = [f"{r['pooled']['questions']:.1f} q, {r['pooled']['demo_share']:.0%}"
+                 + (_turns_cell(r["pooled"]) if c.get("until_budget_spent") else "")
                  if (r := cell.get((c["name"], strategy))) else "–" for c in conditions]
         lines.append(f"| {strategy} | " + " | ".join(cells) + " |")
     return "\n".join(lines)
+
+
+def _turns_cell(pooled: dict) -> str:
+    """, 155 / 140 turns, 2 at the bound" for a condition that runs until its budget is spent."""
+    return f", {pooled['turns_mean']:.0f} / {pooled['turns_median']:g} turns, {pooled['at_bound']} at the bound"
 
 
 def _episodes_per_cell(conditions: list[dict]) -> str:

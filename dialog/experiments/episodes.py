@@ -58,6 +58,7 @@ class EpisodeSpec:
         return EpisodeSettings(task=self.task, kitchen=self.kitchen, strategy=self.strategy, seed=self.episode_seed,
                                turns=condition.turns, budget=condition.budget, change_every=condition.change_every,
                                costs=dict(self.costs), seconds=condition.seconds,
+                               until_budget_spent=condition.until_budget_spent,
                                weights=None if self.weights is None else self.weights.record())
 
 
@@ -107,7 +108,7 @@ def _run_episode(spec: EpisodeSpec, strategy: Strategy | None = None) -> dict:
                                say=lambda _: None, clock=timing.clock, observers=(turns,)).run()
     series = series_from_transcript(turns.records)
     return {"spec": asdict(spec), "label": spec.label, "series": series, "accuracy": result.accuracy,
-            "decision_terms": turns.terms, "seconds": time.perf_counter() - started,
+            "decision_terms": turns.terms, "ended": result.ended, "seconds": time.perf_counter() - started,
             "cpu_seconds": time.process_time() - started_cpu}
 
 

@@ -24,7 +24,8 @@ def write_episode_csvs(results: list[dict], out: Path) -> Path:
     with open(summary_path, "w", newline="") as summary_file:
         summary = csv.writer(summary_file)
         summary.writerow(["condition", "strategy", "dataset", "seed", "accuracy", "questions", "label", "demo",
-                          "feature", "spent", "seconds", "csv", "quiet_with_budget_left", "quiet_terms"])
+                          "feature", "spent", "seconds", "csv", "quiet_with_budget_left", "quiet_terms", "turns",
+                          "ended"])
         for result in results:
             spec, series = result["spec"], result["series"]
             path = out / "episodes" / spec["condition"]["name"] / f"{file_label(spec['strategy'])}" \
@@ -37,7 +38,8 @@ def write_episode_csvs(results: list[dict], out: Path) -> Path:
             summary.writerow([spec["condition"]["name"], spec["strategy"], spec["dataset"], spec["seed"],
                               f"{result['accuracy']:.4f}", series["questions"][-1], series["label"][-1],
                               series["demo"][-1], series["feature"][-1], series["spent"][-1],
-                              f"{result['seconds']:.2f}", path.relative_to(out), *quiet_columns(result)])
+                              f"{result['seconds']:.2f}", path.relative_to(out), *quiet_columns(result),
+                              len(series["turn"]), result.get("ended", "")])
     return summary_path
 
 
@@ -47,6 +49,19 @@ def questions_and_demo_share(group: list[dict], suite: Suite) -> tuple[float, fl
     share = float(np.mean([r["series"]["demo"][-1] * suite.costs.get("demo", 2) / max(r["series"]["spent"][-1], 1e-9)
                            for r in group]))
     return questions, share
+
+
+def turns_used(group: list[dict]) -> dict:
+    """Turns the episodes of a group played: mean, median, and how many ended at the safety bound (chapter-6
+    conditions that run until the budget is spent; ``EpisodeResult.ended``)."""
+    turns = [len(r["series"]["turn"]) for r in group]
+    return {"turns_mean": float(np.mean(turns)), "turns_median": float(np.median(turns)),
+            "at_bound": sum(r.get("ended") == "bound" for r in group)}
+
+
+def until_budget_spent_in_words(condition) -> str:
+    """How a condition that ends on its budget reads in a heading (the bound in turns)."""
+    return f"until the budget is spent (bound {condition.turns} turns), "
 
 
 def _fmt_p(p: float) -> str:
@@ -152,6 +167,7 @@ def markdown_report(suite: Suite, results: list[dict], summaries: list[Checkpoin
     for condition in suite.conditions:
         embodied = "" if condition.seconds is None else \
             f"embodied costs, {condition.seconds:g} s (at most {condition.turns} turns), "
+        embodied = until_budget_spent_in_words(condition) if condition.until_budget_spent else embodied
         lines += [f"## Condition `{condition.name}`: budget {condition.budget:g}, "
                   f"{embodied or f'{condition.turns} turns, '}a new scene every {condition.change_every} turns, "
                   f"{condition.scene_size(scene_default)} objects a scene"
@@ -168,7 +184,7 @@ def markdown_report(suite: Suite, results: list[dict], summaries: list[Checkpoin
                       f"{condition.turns} turns.", ""]
             continue
         note = f" (checkpoints {left_out} lie beyond its {condition.turns} turns)" if left_out else ""
-        used = [] if condition.seconds is None else ["used"]
+        used = ["used"] if condition.seconds is not None or condition.until_budget_spent else []
         lines += [f"Mean held-out accuracy ± standard error after this many {axis_name}{note}:", "",
                   "| strategy | " + " | ".join([*(f"after {c} {axis_name}" for c in checkpoints), *used])
                   + " | questions | demo share |", "|---" * (len(checkpoints) + 3 + len(used)) + "|"]
@@ -179,7 +195,15 @@ def markdown_report(suite: Suite, results: list[dict], summaries: list[Checkpoin
             if condition.seconds is not None:  # embodied costs: how many turns and seconds the episodes took
                 turns = np.mean([r["series"]["turn"][-1] for r in group])
                 cells += f" | {turns:.1f} turns, {np.mean([r['series']['seconds'][-1] for r in group]):.0f} s"
+            elif condition.until_budget_spent:  # the thesis's ending: turns taken (mean / median), at the bound
+                taken = turns_used(group)
+                cells += f" | {taken['turns_mean']:.1f} / {taken['turns_median']:g} turns, {taken['at_bound']} of " \
+                         f"{len(group)} at the bound"
             lines.append(f"| {summary.strategy} | {cells} | {questions:.1f} | {demo_cost:.0%} |")
+        if condition.until_budget_spent:
+            lines += ["", f"Episodes run until the budget is spent; \"used\" gives the turns they took (mean / "
+                          f"median), and how many reached the bound of {condition.turns} turns with budget left "
+                          "(scored where they stopped)."]
         lines += ["", *quiet_table(groups, condition.name, [summary.strategy for summary in rows])]
         column = len(checkpoints) - 1
         lines += ["", f"Exploratory (not corrected, not planned): two-sided tests between every pair of strategies "

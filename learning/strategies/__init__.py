@@ -14,6 +14,8 @@ all-cd     All/CD: feature query, a few demos keeping classes uniform, then A
 dt         DT with the weights in learning/decision/presets/dt.toml (or ``weights=``)
 dt-iros    DT on ACD and CDU (thesis ch. 6)
 dt-task    DT on ACD, CDU, IV and PM (thesis ch. 7)
+dt-iros-v1 dt-iros's hand-set weights from before the calibration rule (docs/calibration.md)
+dt-task-v1 dt-task's hand-set weights from before the calibration rule (docs/calibration.md)
 dt-task-env DT on the seven decision features and the expert-habit ones (thesis ch. 7; IRL weights, issue 27)
 dt-task-env-thesis DT-task-env on the thesis's seven features only (the earlier trajectory-level IRL fit)
 dt-task-env-no-env ablation: dt-task-env's weights without the environment features (docs/irl.md)
@@ -57,6 +59,8 @@ STRATEGIES: dict[str, Callable[..., Strategy]] = {
     "dt": partial(DecisionTheoreticStrategy, "dt"),
     "dt-iros": partial(DecisionTheoreticStrategy, "dt-iros"),
     "dt-task": partial(DecisionTheoreticStrategy, "dt-task"),
+    "dt-iros-v1": partial(DecisionTheoreticStrategy, "dt-iros-v1"),
+    "dt-task-v1": partial(DecisionTheoreticStrategy, "dt-task-v1"),
     "dt-task-env": partial(DecisionTheoreticStrategy, "dt-task-env"),
     "dt-task-env-thesis": partial(DecisionTheoreticStrategy, "dt-task-env-thesis"),
     "dt-task-env-no-env": partial(DecisionTheoreticStrategy, "dt-task-env-no-env"),
