@@ -332,6 +332,9 @@ class DialogManager:
                 continue
             turn, what = self._undo_stack[-1 - len(undone)][:2]
             undone.append(turn)
+            refunded = sum(entry[2].cost for entry in self._undo_stack[len(self._undo_stack) - len(undone):])
+            if hasattr(self.teacher, "budget_changed"):  # the page's budget line follows the undo at once
+                self.teacher.budget_changed(prompt.budget_left + refunded)
             self.teacher_tell(f"Taken back: {what} (turn {turn}); that question is not asked again unless I choose "
                               f"it again. Now: {prompt.text}")
         outcome.lines, outcome.channels = lines, channels
