@@ -35,6 +35,8 @@ def test_one_label_that_fixes_many_predictions_is_asked():
     prior = np.vstack([rng.normal((-3, 0), 0.3, (4, 2)), rng.normal((3, 0), 0.3, (4, 2))])
     cluster = rng.normal((0, 3), 0.05, (8, 2))
     scene = np.vstack([[(-3, 0)], cluster])
+    # with every kind priced it asks too (a demonstration: DT's p(x|y) treats the cluster's objects as
+    # independent, so one of them is likely the one shown; docs/strategies.md, limits)
     every_kind = state_with(prior, ["apple"] * 4 + ["cup"] * 4, scene)
     assert make_strategy("dt-voi").choose(every_kind, np.random.default_rng(0)).action != NoQuery()
     state = state_with(prior, ["apple"] * 4 + ["cup"] * 4, scene, costs=LABELS_ONLY)
