@@ -28,6 +28,7 @@ of cost k costs k lambda. The robot asks the question with the largest gain - pr
 
 from __future__ import annotations
 
+import hashlib
 from dataclasses import dataclass
 
 import numpy as np
@@ -35,6 +36,7 @@ import numpy as np
 from learning.actions import Action, DemoQuery, LabelQuery
 from learning.decision.candidates import _normalised, candidate_actions
 from learning.decision.features import label_distribution
+from learning.whatif.base import cached
 from learning.whatif.fast import feature_outcomes, pair_table
 
 LOSSES = ("error", "log", "error-after")
@@ -101,11 +103,15 @@ def voi_gains(state, pool: np.ndarray | None, loss: str = "error") -> Gains:
         return Gains(queries, np.zeros(len(queries)), np.zeros(len(queries)), judged,
                      price_rule(state.remaining_budget, cheapest, turns_left, 0.0))
     P = state.probabilities(rows)
-    table = pair_table(state, pool if len(pool) else None)  # [j, y, i, c], j and i over the judged rows
+    extra = pool if len(pool) else None
+    # one model version, scene and pool give one table: a quiet turn reuses the last one (as DT's engine does)
+    version = (state.version, state.scene_id, hashlib.sha1(np.ascontiguousarray(pool).tobytes()).hexdigest())
+    table = cached(state, "voi.pairs", version, lambda: pair_table(state, extra))  # [j, y, i, c] over judged rows
     q = label_distribution(P)  # p(y | row j)
     label_cost = state.costs["label"]
 
-    features = [feature_outcomes(state, pool if len(pool) else None)] if queries[-1].kind == "feature" else []
+    features = [cached(state, "voi.feature", version, lambda: feature_outcomes(state, extra))] \
+        if queries[-1].kind == "feature" else []
 
     def gains_in(loss_name: str):
         pair_value = answer_value(P, table, loss_name)  # (judged, |Y|): the value of answer <row j, concept y>
