@@ -9,7 +9,8 @@ value of information: the better decision after the answer against the decision 
     "error":  sum_i P'[i, argmax P'_i] - P'[i, argmax P_i]   (expected objects right that change), or
     "log":    sum_i KL(P'_i || P_i)                         (expected log loss saved on the judged rows),
 
-both >= 0; "error" is exactly 0 when no answer would change any prediction (nothing is uncertain enough
+both >= 0 (``error-after``, Roy & McCallum's sum_i max P'_i - max P_i, was tried too; docs/strategies.md);
+"error" is exactly 0 when no answer would change any prediction (nothing is uncertain enough
 to matter). The gain of a question is its answers' values weighted as DT weighs them
 (``learning.decision.candidates``): a label of object x by p(y|x), a demonstration of y by p(x|y) over
 the scene, the feature question's answers F_{y,c} 1/|Y| each. P' comes from the fast what-if engine run on
