@@ -21,6 +21,7 @@ dt-task-env-thesis DT-task-env on the thesis's seven features only (the earlier 
 dt-task-env-no-env ablation: dt-task-env's weights without the environment features (docs/irl.md)
 dt-task-habits ablation: DT-task's learning weights with dt-task-env's habit-feature weights (docs/irl.md)
 scripted-expert the scripted expert of thesis §7.4.1 (rules in data/scripted-expert.toml)
+dt-voi     the question whose expected gain in objects right beats its price, from the allocation (beyond the thesis)
 rl:FILE    a trained questioner policy (teachbot train-questioner; beyond the thesis)
 pkg.mod:Cls your own strategy class, imported from an importable module (runs your code; plugins.py)
 ========== ==================================================================
@@ -48,6 +49,7 @@ from learning.strategies.random_choice import RandomStrategy
 from learning.strategies.rl_questioner import PREFIX as RL_PREFIX
 from learning.strategies.rl_questioner import RLQuestionerStrategy
 from learning.strategies.scripted_expert import ScriptedExpertStrategy
+from learning.strategies.voi import ValueOfInformationStrategy
 
 STRATEGIES: dict[str, Callable[..., Strategy]] = {
     "passive": PassiveStrategy,
@@ -68,6 +70,7 @@ STRATEGIES: dict[str, Callable[..., Strategy]] = {
     "scripted-expert": ScriptedExpertStrategy,
     "passive-fs": PassiveFeatureSelectingStrategy,
     "active-fs": ActiveFeatureSelectingStrategy,
+    "dt-voi": ValueOfInformationStrategy,
 }
 STRATEGY_NAMES = tuple(STRATEGIES)
 # the strategy of the library's TeachingLoop, of EpisodeSettings, and of teach and demo, written once
