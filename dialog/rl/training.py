@@ -26,7 +26,7 @@ from learning.rl.observation import ObservationLayout
 from learning.rl.policy_file import QuestionerPolicy
 
 HIDDEN = (64, 64)
-ESTIMATE_TURNS = 24  # turns of the first environment timed before training, for the time estimate
+ESTIMATE_EPISODES, ESTIMATE_TURNS = 2, 60  # timed before training for the time estimate: at least this many of each
 
 
 @dataclass(frozen=True)
@@ -137,12 +137,15 @@ def train(config: TrainingConfig, progress: bool = True, provenance: dict | None
     say("loading the training data sets (rendered in the simulated kitchen on the first run, then cached)...")
     probe = make_env(config.env)()  # validates the options here, once, and renders the data sets if needed
     layout = probe.layout
+    loading = time.perf_counter() - started  # the training environments load the same data sets again
     per_turn = seconds_per_turn(probe, config.seed)
     probe.close()
-    estimate = per_turn * config.steps / min(config.envs, os.cpu_count() or 1)
-    say(f"this will take about {_duration(estimate)} ({per_turn * 1000:.0f} ms per turn, timed on {ESTIMATE_TURNS} "
-        f"turns of one environment, x {config.steps} steps over {config.envs} environment(s); PPO's updates add "
-        "little)")
+    so_far = time.perf_counter() - started
+    estimate = so_far + loading + per_turn * config.steps / min(config.envs, os.cpu_count() or 1)
+    say(f"this will take about {_duration(estimate)} in all: {so_far:.0f} s so far, {loading:.0f} s to start the "
+        "environments, then "
+        f"{config.steps} steps at {per_turn * 1000:.0f} ms per turn over {config.envs} environment(s) (timed on "
+        f"{ESTIMATE_EPISODES}+ whole episodes of random questions)")
     say(f"starting {config.envs} environment{'s' if config.envs > 1 else ''}"
         f"{' in worker processes' if config.envs > 1 else ''}, then training...")
     vec_cls = SubprocVecEnv if config.envs > 1 else DummyVecEnv
@@ -178,17 +181,20 @@ def train(config: TrainingConfig, progress: bool = True, provenance: dict | None
     return actor_policy(model, layout, record), summary
 
 
-def seconds_per_turn(env, seed: int, turns: int = ESTIMATE_TURNS) -> float:
-    """CPU-bound wall seconds per environment step, from ``turns`` steps of uniformly random candidate slots
-    (resets included as they come); the environment is left to be closed or reset by the caller."""
+def seconds_per_turn(env, seed: int, episodes: int = ESTIMATE_EPISODES, turns: int = ESTIMATE_TURNS) -> float:
+    """Wall seconds per environment step over whole episodes of uniformly random candidate slots (what an
+    untrained masked policy plays): at least ``episodes`` episodes and ``turns`` turns, resets included, since a
+    turn's cost grows with the examples learned and so with the episode's allocation and its progress."""
     rng = np.random.default_rng(seed)
-    started = time.perf_counter()
-    _, info = env.reset(seed=seed)
-    for _ in range(turns):
-        _, _, terminated, _, info = env.step(int(rng.choice(np.flatnonzero(info["action_mask"]))))
-        if terminated:
-            _, info = env.reset(seed=seed + 1)
-    return (time.perf_counter() - started) / turns
+    started, played, ended = time.perf_counter(), 0, 0
+    while ended < episodes or played < turns:
+        _, info = env.reset(seed=seed + ended)
+        terminated = False
+        while not terminated:
+            _, _, terminated, _, info = env.step(int(rng.choice(np.flatnonzero(info["action_mask"]))))
+            played += 1
+        ended += 1
+    return (time.perf_counter() - started) / played
 
 
 def _duration(seconds: float) -> str:
