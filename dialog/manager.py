@@ -38,12 +38,12 @@ from learning.state import LearningState
 from learning.strategies import Strategy
 from learning.strategies.check import refuse_invalid_decision
 from learning.strategies.plugins import is_plugin
-from learning.turn import admissible, scene_epoch
+from learning.turn import admissible, budget_spent, scene_epoch
 
 __all__ = ["DialogManager", "EpisodeConfig", "EpisodeResult", "episode_generators", "question_text"]
 
 STREAMS = ("scenes", "test", "strategy", "teacher", "pantry")
-OBSERVER_EVENTS = ("on_scene", "on_question", "on_answer", "on_turn")
+OBSERVER_EVENTS = ("on_scene", "on_decision", "on_question", "on_answer", "on_turn")
 
 
 @dataclass
@@ -62,6 +62,9 @@ class EpisodeResult:
     #: turns that is (the turn in progress when the seconds ran out does not count, docs/experiments.md)
     allocation_accuracy: float | None = None
     allocation_turns: int = 0
+    #: why the episode ended: "budget" (spent, the chapter-6 ending), "bound" (the turns ran out while ending
+    #: on the budget), "turns" (the allocation's turns), "seconds" (embodied costs) or "quit"
+    ended: str = "turns"
 
 
 def episode_generators(seed: int) -> dict[str, np.random.Generator]:
@@ -119,6 +122,7 @@ class DialogManager:
                 "fetch_from_pantry": config.fetch_from_pantry, "strategy": self.strategy.name,
                 "concepts": list(self.env.concepts), "features": len(self.env.feature_names),
                 **getattr(self.strategy, "header_fields", dict)(), **self.session,
+                **({"until_budget_spent": True} if config.until_budget_spent else {}),
                 **({} if self.embodied is None else {"seconds": config.seconds,
                                                      "embodied_costs": self.embodied.record()})}
 
@@ -135,6 +139,8 @@ class DialogManager:
         self.begin()
         replay = list(replay)
         while self.turn < self.config.turns and not self.quit:
+            if self.config.until_budget_spent and budget_spent(self.state):
+                break
             if self.turn < len(replay):
                 self.replay_turn(replay[self.turn])
             elif self.out_of_time():
@@ -153,7 +159,16 @@ class DialogManager:
             accuracy=self.test_accuracy(), transcript=str(self.transcript.path),
             seconds=seconds, completed=self.turn, quit=self.quit,
             allocation_accuracy=self._within_allocation[0], allocation_turns=self._within_allocation[1],
+            ended=self.ending(),
         )
+
+    def ending(self) -> str:
+        """Why the episode ended, or would end now (``EpisodeResult.ended``)."""
+        if self.quit:
+            return "quit"
+        if self.config.until_budget_spent:
+            return "budget" if budget_spent(self.state) else "bound"
+        return "seconds" if self.out_of_time() else "turns"
 
     # -- the clock and the world ---------------------------------------------------
     def out_of_time(self) -> bool:
@@ -214,6 +229,7 @@ class DialogManager:
         if action is None:
             decision = self.strategy.choose(self.state, self.rngs["strategy"])
             action, explanation = decision.action, decision.explanation
+            self._notify("on_decision", decision)
         chosen = action
         action, reason = admissible(self.state, chosen)  # learning.turn: the library's rules
         if action != chosen and is_plugin(self.strategy):  # the user's code is held to the contract, not mended
@@ -316,6 +332,9 @@ class DialogManager:
                 continue
             turn, what = self._undo_stack[-1 - len(undone)][:2]
             undone.append(turn)
+            refunded = sum(entry[2].cost for entry in self._undo_stack[len(self._undo_stack) - len(undone):])
+            if hasattr(self.teacher, "budget_changed"):  # the page's budget line follows the undo at once
+                self.teacher.budget_changed(prompt.budget_left + refunded)
             self.teacher_tell(f"Taken back: {what} (turn {turn}); that question is not asked again unless I choose "
                               f"it again. Now: {prompt.text}")
         outcome.lines, outcome.channels = lines, channels

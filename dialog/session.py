@@ -105,8 +105,9 @@ def check_header(header: dict, path) -> None:
     seconds = header.get("seconds")
     if seconds is not None and not (_is_number(seconds) and seconds > 0 and realtime is None):
         raise refuse("seconds", "null or a positive number of seconds (embodied costs; not with realtime)")
-    if not isinstance(header.get("fetch_from_pantry", True), bool):
-        raise refuse("fetch_from_pantry", "true or false")
+    for name in ("fetch_from_pantry", "until_budget_spent"):
+        if not isinstance(header.get(name, True), bool):
+            raise refuse(name, "true or false")
     costs = header.get("costs", DEFAULT_COSTS)
     if not (isinstance(costs, dict) and set(costs) == set(DEFAULT_COSTS)
             and all(_is_number(v) and v >= 0 for v in costs.values())):

@@ -79,16 +79,20 @@ class EpisodeSettings:
     costs: dict = field(default_factory=lambda: dict(DEFAULT_COSTS))
     weights: dict | None = None  # DT with a user's weights: {"file": path, "values": {feature: weight}} (--weights)
     seconds: float | None = None  # embodied costs (thesis §8.2.2): the time allocation in seconds; turns is the cap
+    until_budget_spent: bool = False  # the thesis's chapter-6 ending: stop once the budget is spent; turns is the bound
 
     def __post_init__(self):
         for name, value in (("task", self.task), ("kitchen", self.kitchen), ("strategy", self.strategy)):
             if not isinstance(value, str) or not value:
                 raise SettingsError(f"{name} must be a name, got {value!r}")
         check_allocation(self.turns, self.budget, self.change_every, self.realtime, self.seed, self.seconds)
-        if not isinstance(self.fetch_from_pantry, bool):
-            raise SettingsError(f"fetch_from_pantry must be true or false, got {self.fetch_from_pantry!r}")
+        for name in ("fetch_from_pantry", "until_budget_spent"):
+            if not isinstance(getattr(self, name), bool):
+                raise SettingsError(f"{name} must be true or false, got {getattr(self, name)!r}")
         check_costs(self.costs)
         check_questions(self.turns, self.budget, self.costs)
+        if self.until_budget_spent:
+            check_budget_pays_for_a_question(self.budget, self.costs)
         if self.weights is not None:
             weights_from_record(self.weights)
 
@@ -102,7 +106,18 @@ class EpisodeSettings:
         """The manager's allocation for this episode (``pictures``: folder for scene pictures, None: none)."""
         return EpisodeConfig(turns=self.turns, budget=self.budget, change_every=self.change_every, seed=self.seed,
                              costs=dict(self.costs), realtime=self.realtime, pictures=pictures,
-                             fetch_from_pantry=self.fetch_from_pantry, seconds=self.seconds)
+                             fetch_from_pantry=self.fetch_from_pantry, seconds=self.seconds,
+                             until_budget_spent=self.until_budget_spent)
+
+
+def check_budget_pays_for_a_question(budget: float, costs: dict) -> None:
+    """An episode that ends once its budget is spent needs a budget that pays for some question at the start,
+    else it would end before its first turn (SettingsError naming the cheapest question)."""
+    cheapest = min(float(costs[kind]) for kind in ("label", "demo", "feature"))
+    if cheapest > budget + 1e-9:
+        raise SettingsError(f"until_budget_spent: a budget of {budget:g} pays for no question (the cheapest costs "
+                            f"{cheapest:g}), so the episode would end before its first turn; give a budget of at "
+                            f"least {cheapest:g}")
 
 
 def _is_int(value) -> bool:
@@ -129,6 +144,8 @@ class EpisodeConfig:
     it takes (pointing, fetching, saying the question, the answer; a quiet turn ``dialog.embodied``'s seconds),
     the scene changes every ``change_every`` nominal turns of seconds (as in real-time mode), and the episode
     ends once the seconds are used up or after ``turns`` turns (the cap).
+    until_budget_spent: the thesis's chapter-6 ending: the episode ends after the turn in which the budget
+    became spent (``learning.turn.budget_spent``), or after ``turns`` turns (the safety bound).
     """
 
     turns: int = DEFAULTS.turns
@@ -140,6 +157,7 @@ class EpisodeConfig:
     pictures: str | None = None
     fetch_from_pantry: bool = DEFAULTS.fetch_from_pantry
     seconds: float | None = None
+    until_budget_spent: bool = False
 
     def __post_init__(self):
         check_allocation(self.turns, self.budget, self.change_every, self.realtime, seconds=self.seconds)

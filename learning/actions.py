@@ -50,10 +50,12 @@ Action = LabelQuery | DemoQuery | FeatureQuery | NoQuery
 
 @dataclass(frozen=True)
 class Decision:
-    """A strategy's choice and its one-sentence reason."""
+    """A strategy's choice and its one-sentence reason; a utility-based strategy (DT) adds ``terms``: per weighted
+    feature, its share of EU(best query) - EU(no query) (``learning.decision.reasons.utility_terms``)."""
 
     action: Action
     explanation: str
+    terms: tuple[tuple[str, float], ...] = ()
 
 
 def validate_costs(costs: dict) -> dict[str, float]:

@@ -51,7 +51,11 @@ class Progress:
         return self.budget - self.spent
 
     def can_afford(self, action: Action) -> bool:
-        return self.cost(action) <= self.remaining_budget + 1e-9
+        return self.affords(self.cost(action))
+
+    def affords(self, cost: float) -> bool:
+        """Whether the remaining budget pays for ``cost`` (to within rounding)."""
+        return cost <= self.remaining_budget + 1e-9
 
     def check_affordable(self, action: Action) -> None:
         cost = self.cost(action)

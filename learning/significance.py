@@ -6,8 +6,9 @@ their mean and standard error at each point. Where every strategy plays the
 same episodes (same pools, seeds and scenes) the comparison is paired: the
 Wilcoxon signed-rank test over the shared episodes, its matched-pairs
 rank-biserial effect size, a cluster bootstrap interval of the mean
-difference (episodes of one pool are not independent), and Holm's correction
-over the findings of one table.
+difference (whole clusters resampled: the caller says what the episodes
+share; the suites cluster by data seed), and Holm's correction over the
+findings of one table.
 """
 
 from __future__ import annotations
@@ -44,7 +45,8 @@ class Comparison:
 class PairedComparison:
     """Wilcoxon signed-rank of ``a`` against ``b`` over ``n`` paired episodes (``greater``: a tends to exceed b),
     the matched-pairs rank-biserial ``effect`` r, the median and mean differences, and a 95 % cluster-bootstrap
-    interval ``ci`` of the mean difference a - b."""
+    interval ``ci`` of the mean difference a - b over ``clusters`` clusters (None with a single cluster: nothing
+    to resample)."""
 
     a: str
     b: str
@@ -56,8 +58,8 @@ class PairedComparison:
     n: int
     median_difference: float
     effect: float
-    ci: tuple[float, float]
-    clusters: int  # independent units the interval resampled (pools x data seeds)
+    ci: tuple[float, float] | None
+    clusters: int  # the units the interval resampled (the suites': data seeds)
     p_holm: float | None = None
 
     @property
@@ -78,9 +80,11 @@ def rank_biserial(differences) -> float:
 
 
 def cluster_bootstrap_ci(differences, clusters, rng: np.random.Generator, resamples: int = 2000,
-                         level: float = 0.95) -> tuple[float, float]:
-    """Percentile interval of the mean of ``differences`` when whole clusters (e.g. training pools of one data
-    seed, whose episodes share data) are resampled with replacement; a single cluster gives (mean, mean)."""
+                         level: float = 0.95) -> tuple[float, float] | None:
+    """Percentile interval of the mean of ``differences`` when whole clusters (e.g. the data seeds, whose
+    episodes share a test pool) are resampled with replacement; None for a single cluster (it has no spread
+    to resample: no interval rather than a zero-width one). With one difference per cluster it is the plain
+    bootstrap."""
     d = np.asarray(differences, dtype=float)
     clusters = list(clusters)
     first_seen = {label: i for i, label in enumerate(dict.fromkeys(clusters))}  # any hashable label, in order
@@ -91,7 +95,7 @@ def cluster_bootstrap_ci(differences, clusters, rng: np.random.Generator, resamp
     sums = np.array([d[labels == u].sum() for u in units])
     counts = np.array([np.sum(labels == u) for u in units])
     if len(units) == 1:
-        return float(d.mean()), float(d.mean())
+        return None
     picks = rng.integers(0, len(units), size=(resamples, len(units)))
     means = sums[picks].sum(axis=1) / counts[picks].sum(axis=1)
     tail = (1.0 - level) / 2.0
@@ -101,7 +105,8 @@ def cluster_bootstrap_ci(differences, clusters, rng: np.random.Generator, resamp
 def wilcoxon_paired(name_a: str, a, name_b: str, b, alternative: str = "two-sided", clusters=None,
                     rng: np.random.Generator | None = None) -> PairedComparison:
     """Wilcoxon signed-rank test of paired samples ``a`` and ``b`` (one value each per shared episode), zero
-    differences dropped as in Wilcoxon's original test; ``clusters`` (one label per pair) for the interval."""
+    differences dropped as in Wilcoxon's original test; ``clusters`` (one label per pair) for the interval (None:
+    every pair its own cluster, the plain bootstrap)."""
     if alternative not in ALTERNATIVES:
         raise ValueError(f"alternative must be one of {', '.join(ALTERNATIVES)}, got '{alternative}'")
     a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)

@@ -39,3 +39,12 @@ def scene_due(turns_finished: int, change_every: int, last_scene_epoch: int | No
     """True when the next turn needs a new scene: none seen yet (``last_scene_epoch`` None), or a new block of
     ``change_every`` turns has begun since the last one was observed."""
     return last_scene_epoch is None or scene_epoch(turns_finished, change_every) > last_scene_epoch
+
+
+def budget_spent(state: LearningState) -> bool:
+    """True when the remaining budget can pay for no question the learner may still ask: neither a label nor a
+    demonstration query, nor the feature query if it has not been asked. The thesis's chapter-6 episodes end
+    after the turn in which this becomes true (docs/experiments.md, "How a chapter-6 episode ends"); a kind
+    that costs nothing is always affordable, so such a budget is never spent."""
+    kinds = ("label", "demo") if state.feature_query_asked else ("label", "demo", "feature")
+    return not any(state.progress.affords(state.costs[kind]) for kind in kinds)

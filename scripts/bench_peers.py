@@ -12,6 +12,8 @@ Methods:
 - ``teachbot-entropy``: TeachingLoop(strategy="active"), entropy sampling with label queries only.
 - ``teachbot-dt-labels``: the same DT with only label queries priced, as the peers have (a demonstration
   or the feature query costs more than the whole budget, so never a candidate): label queries or none.
+- ``teachbot-voi`` and ``teachbot-voi-labels``: the same two settings with ``dt-voi`` (issue 40: the query
+  whose expected gain in objects right beats its price from the allocation, else none).
 - ``skactiveml-us``: UncertaintySampling(method="entropy"), and ``skactiveml-eer``: MonteCarloEER
   (misclassification loss), both on scikit-learn's GaussianProcessClassifier with teachbot's fixed kernel
   (4.0 * RBF(sqrt |F|), no optimiser) on pool-standardised features; one label query per turn while the
@@ -23,9 +25,10 @@ Methods:
   candidate), as skactiveml's wrapper does.
 
 Comparable rows: the label-only ones ask the same kind of question at the same price: teachbot-entropy,
-skactiveml-us and modal-entropy (entropy sampling, a label every turn the budget allows); teachbot-dt-labels
-and skactiveml-eer (expected-utility or expected-error choices among labels; DT may also stay quiet).
-teachbot-dt is not comparable in accuracy: it also buys demonstrations (cost 2) and asks a feature query.
+skactiveml-us and modal-entropy (entropy sampling, a label every turn the budget allows); teachbot-dt-labels,
+teachbot-voi-labels and skactiveml-eer (expected-utility or expected-error choices among labels; DT and dt-voi
+may also stay quiet). teachbot-dt and teachbot-voi are not comparable in accuracy: they may also buy
+demonstrations (cost 2) and ask a feature query.
 
 Timing: CPU time of this process (the machine is shared; other programs do not inflate it); one decision
 is ``TeachingLoop.ask()`` or ``query()``; refitting after an answer is outside it
@@ -59,15 +62,20 @@ from sklearn.model_selection import train_test_split  # noqa: E402
 from learning import TeachingLoop  # noqa: E402
 
 DATASETS = {"iris": load_iris, "wine": load_wine, "breast-cancer": load_breast_cancer, "digits": load_digits}
-METHODS = ("teachbot-dt", "teachbot-dt-labels", "teachbot-entropy", "skactiveml-us", "skactiveml-eer",
-           "modal-entropy")
-TEACHBOT_STRATEGIES = {"teachbot-dt": "dt-task", "teachbot-dt-labels": "dt-task", "teachbot-entropy": "active"}
+METHODS = ("teachbot-dt", "teachbot-dt-labels", "teachbot-voi", "teachbot-voi-labels", "teachbot-entropy",
+           "skactiveml-us", "skactiveml-eer", "modal-entropy")
+TEACHBOT_STRATEGIES = {"teachbot-dt": "dt-task", "teachbot-dt-labels": "dt-task", "teachbot-voi": "dt-voi",
+                       "teachbot-voi-labels": "dt-voi", "teachbot-entropy": "active"}
+LABELS_ONLY = ("teachbot-dt-labels", "teachbot-voi-labels")
 COMPARABLE = {"teachbot-dt": "not comparable (demonstrations and the feature query too)",
               "teachbot-dt-labels": "labels only: vs skactiveml-eer",
-              "skactiveml-eer": "labels only: vs teachbot-dt-labels",
+              "teachbot-voi": "not comparable (demonstrations and the feature query too)",
+              "teachbot-voi-labels": "labels only: vs skactiveml-eer and the entropy rows",
+              "skactiveml-eer": "labels only: vs teachbot-dt-labels, teachbot-voi-labels",
               "teachbot-entropy": "entropy, labels only", "skactiveml-us": "entropy, labels only",
               "modal-entropy": "entropy, labels only"}
 RATIOS = (("teachbot-dt", "skactiveml-eer"), ("teachbot-dt-labels", "skactiveml-eer"),
+          ("teachbot-voi-labels", "skactiveml-eer"), ("teachbot-voi-labels", "teachbot-entropy"),
           ("teachbot-entropy", "skactiveml-us"), ("teachbot-entropy", "modal-entropy"))
 
 
@@ -96,7 +104,7 @@ def scenes_for(pool_size: int, args, rng: np.random.Generator) -> list[np.ndarra
 
 def run_teachbot(method: str, X, y, scenes, X_test, y_test, args, seed: int) -> dict:
     costs = None  # teachbot's own: label 1, demonstration 2, feature query 2
-    if method == "teachbot-dt-labels":  # only labels priced: anything else costs more than the whole budget
+    if method in LABELS_ONLY:  # only labels priced: anything else costs more than the whole budget
         costs = {"label": 1, "demo": args.budget + 1, "feature": args.budget + 1}
     loop = TeachingLoop(np.unique(y), strategy=TEACHBOT_STRATEGIES[method], budget=args.budget, turns=args.turns,
                         change_every=args.change_every, costs=costs, seed=seed)

@@ -18,6 +18,7 @@ import umsgpack
 from meshcat.geometry import Object
 from PIL import Image, ImageDraw, ImageFont
 
+from bullet_world.viewer import meshes
 from bullet_world.viewer.meshes import read_obj
 from bullet_world.viewer.scene import Frame, Look, same_pose, translation
 
@@ -94,7 +95,7 @@ def _mesh_geometry(file: str, with_uvs: bool) -> dict:
     files for meshcat's loaders in the page."""
     kind = Path(file).suffix.lower().lstrip(".")
     if kind == "obj":
-        return read_obj(file, with_uvs).geometry_json(_uuid())
+        return read_obj(file, with_uvs, meshes.VIEWER_TRIANGLES).geometry_json(_uuid())
     return {"uuid": _uuid(), "type": "_meshfile_geometry", "format": kind, "data": _mesh_data(file)}
 
 

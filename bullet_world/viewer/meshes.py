@@ -4,6 +4,14 @@ meshcat can parse OBJ text in the browser, but it fails on files whose
 groups differ in their attributes (some of the Panda's links) and parsing
 9 MB of text in the page is slow. Reading the file here once, with numpy,
 gives compact binary arrays that every page and the exported HTML load as is.
+
+A browser without a GPU (headless Chromium, many study laptops) draws in
+software, where a frame costs about as much as its triangles: the Panda's links
+hold 600-21,600 triangles each, about 100,000 in all. Meshes without texture
+coordinates are simplified for the viewer to at most ``VIEWER_TRIANGLES``
+triangles each by quadric edge collapse (Garland and Heckbert's quadric error
+metric, through the fast-simplification package), which keeps the outline
+within a millimetre or two (tests/bullet_world/test_viewer_mesh_simplify.py).
 """
 
 from __future__ import annotations
@@ -20,6 +28,8 @@ from meshcat.geometry import pack_numpy_array
 
 from bullet_world.datafiles import cache_dir, write_atomically
 from learning.errors import DataFileError
+
+VIEWER_TRIANGLES = 3000  # the most triangles one mesh is drawn with in the viewer (see above)
 
 
 class MeshFileError(DataFileError):
@@ -89,16 +99,31 @@ def _absolute(indices: np.ndarray, count: int) -> np.ndarray:
     return np.where(indices > 0, indices - 1, np.where(indices < 0, count + indices, -1))
 
 
+def simplified(mesh: MeshArrays, triangles: int) -> MeshArrays:
+    """The mesh with at most about ``triangles`` triangles, by quadric edge collapse; a mesh with texture
+    coordinates, or already small enough, is returned as it is (a collapse would tear its texture mapping)."""
+    if mesh.uvs is not None or len(mesh.faces) <= triangles:
+        return mesh
+    import fast_simplification
+
+    points, faces = fast_simplification.simplify(mesh.positions.astype(np.float64), mesh.faces.astype(np.int32),
+                                                 target_count=int(triangles))
+    return MeshArrays(points.astype(np.float32), None, faces.astype(np.uint32))
+
+
 @lru_cache(maxsize=64)
-def read_obj(file: str, with_uvs: bool = False) -> MeshArrays:
-    """An OBJ file's triangles (see :func:`parse_obj`), kept as NPZ in the teachbot cache folder so that
-    later sessions skip the parsing (the Panda's visual meshes are 9 MB of text)."""
+def read_obj(file: str, with_uvs: bool = False, max_triangles: int | None = None) -> MeshArrays:
+    """An OBJ file's triangles (see :func:`parse_obj`), simplified to ``max_triangles`` when given and it has no
+    uvs (:func:`simplified`), kept as NPZ in the teachbot cache folder so that later sessions skip the parsing
+    (the Panda's visual meshes are 9 MB of text) and the simplification."""
     try:
         stat = Path(file).stat()
-        key = hashlib.sha1(f"{Path(file).resolve()}|{stat.st_size}|{stat.st_mtime_ns}|{with_uvs}".encode())
+        key = hashlib.sha1(f"{Path(file).resolve()}|{stat.st_size}|{stat.st_mtime_ns}|{with_uvs}|{max_triangles}"
+                           .encode())
         cached = cache_dir() / f"viewer-mesh-{key.hexdigest()[:20]}.npz"
     except OSError:
-        return parse_obj(file, with_uvs)
+        mesh = parse_obj(file, with_uvs)
+        return mesh if max_triangles is None else simplified(mesh, max_triangles)
     if cached.is_file():
         try:
             with np.load(cached, allow_pickle=False) as data:
@@ -106,6 +131,8 @@ def read_obj(file: str, with_uvs: bool = False) -> MeshArrays:
         except (OSError, ValueError, KeyError):
             pass  # a damaged cache file is parsed again and replaced
     mesh = parse_obj(file, with_uvs)
+    if max_triangles is not None:
+        mesh = simplified(mesh, max_triangles)
     buffer = io.BytesIO()
     arrays = {"positions": mesh.positions, "faces": mesh.faces} | ({"uvs": mesh.uvs} if mesh.uvs is not None else {})
     np.savez(buffer, **arrays)

@@ -104,7 +104,7 @@ def _run(args) -> int:
                             continue_command=again)
     if not args.again:
         runner.plan(args.condition, False)  # refuses a participant already done before the page opens
-    page = WebPage(args, title=f"Study '{study.name}'")
+    page = WebPage(args)  # the participant's title: the study's name is the researcher's
     ending = ""  # the runner's "All sessions are done", or why the run stopped
     try:
         runner.page = page
@@ -113,8 +113,8 @@ def _run(args) -> int:
         if not page.teacher.ended:  # quit, Ctrl-C
             ending = "The run stopped. What is done is saved; it goes on from there when it is started again."
         return code
-    except TeachbotError as error:  # a full disk, a damaged record: the page says what stopped the run
-        ending = f"The run stopped: {error}"
+    except TeachbotError:  # a full disk, a damaged record: the terminal says what; the page, that it stopped
+        ending = "The run stopped because of a problem on the computer. What is done is saved."
         raise
     except KeyboardInterrupt:
         ending = "The run was interrupted. What is done is saved; it goes on from there when it is started again."

@@ -27,6 +27,7 @@ from dialog.transcripts.jsonl import read_session
 from dialog.transcripts.lock import TranscriptLock
 from dialog.user_weights import add_weights_option, weights_strategy
 from dialog.viewer import add_viewer_option, hold_viewer, start_viewer, stop_viewer
+from dialog.web import words
 from dialog.web.session import add_web_options, check_web_options, web_continue_options
 from learning.errors import OutputPathError, SettingsError, TranscriptError
 from learning.strategies import DEFAULT_STRATEGY, STRATEGY_NAMES
@@ -181,42 +182,59 @@ def _teach(args, settings: SessionSettings, path: Path, lock: TranscriptLock, in
                  f"strategy {settings.strategy}"
                  f"{'' if settings.weights is None else ' with the weights in ' + settings.weights['file']}. "
                  f"Transcript: {path}")
+        plain = words.intro(environment.concepts, settings.turns) if page is not None else None
         if records:
             intro += f" (resuming after turn {len(records)})"
         if len(records) >= settings.turns:
             intro = (f"{path}: the session is already finished ({len(records)} of {settings.turns} turns); "
                      "nothing to resume")
+            plain = "This session is already finished."
         elif records and settings.seconds is not None and records[-1].get("ended", 0.0) >= settings.seconds:
             intro = (f"{path}: the session is already finished (its {settings.seconds:g} s are used up); "
                      "nothing to resume")
-        manager.say(intro)
+            plain = "This session is already finished."
+        _announce(manager, page, intro, plain)
+        if page is not None and records:  # the page shows the conversation so far
+            page.teacher.recall(records, environment.concepts)
         if person and len(records) < settings.turns and not manager.out_of_time():
-            manager.say("Type 'help' at any question for what you can answer; 'quit' saves and stops.")
+            _announce(manager, page, "Type 'help' at any question for what you can answer; 'quit' saves and stops.",
+                      "")
         again = continue_command(["teachbot", "teach", "--resume", path], args,
                                  UNRECORDED_TEACH_OPTIONS + web_continue_options(args))
         try:
             result = manager.run(replay=records)
         except KeyboardInterrupt:
             ending = f"Interrupted. The session is saved; continue it with: {again}"
-            manager.say(f"\n{ending}")
+            _announce(manager, page, f"\n{ending}", "")
+            if page is not None:
+                ending = "The session was interrupted. What you taught is saved; it can go on later from there."
             return 130
         except OutputPathError as error:
             ending = (f"{error}. The completed turns are saved; once that is fixed, continue with: {again}")
-            raise OutputPathError(ending) from None
+            stopped = OutputPathError(ending)
+            if page is not None:
+                ending = "The session stopped: the computer could not save the next turn. The turns before are saved."
+            raise stopped from None
         finally:
             manager.transcript.close()
         if manager.replay_mismatches:
-            manager.say(f"(note: on {manager.replay_mismatches} replayed turn(s) the strategy would now ask something "
-                        "else; the recorded questions were kept)")
+            _announce(manager, page, f"(note: on {manager.replay_mismatches} replayed turn(s) the strategy would now "
+                                     "ask something else; the recorded questions were kept)", "")
         saved = f"Session saved after {result.completed} of {result.turns} turns. Continue it with: {again}"
+        plain_saved = (f"The session is saved after {result.completed} of {result.turns} turns; it can go on later "
+                       "from there.")
         if result.quit:
-            manager.say(saved)
+            _announce(manager, page, saved, plain_saved)
         summary = (f"Accuracy on {settings.task} held-out scenes: {result.accuracy:.1%} (chance "
                    f"{1 / len(environment.concepts):.0%}); budget spent {result.budget_spent:g} of "
                    f"{settings.budget:g}; questions: {questions_in_words(result.queries)}; "
                    f"{session_time(manager.clock, result.seconds, records)}.")
-        manager.say(summary)
+        plain_summary = (f"The robot now names {result.accuracy:.0%} of the objects in new scenes correctly "
+                         f"(guessing would get {1 / len(environment.concepts):.0%}). Thank you!")
+        _announce(manager, page, summary, plain_summary)
         ending = f"{saved} {summary}" if result.quit else summary
+        if page is not None:  # the page's last words: plain, without the task, the files or the command
+            ending = f"{plain_saved} {plain_summary}" if result.quit else plain_summary
         if args.json:
             print_json({"seed": result.seed, "strategy": result.strategy, "turns": result.turns,
                               "completed": result.completed, "quit": result.quit, "budget_spent": result.budget_spent,
@@ -231,6 +249,17 @@ def _teach(args, settings: SessionSettings, path: Path, lock: TranscriptLock, in
             stop_viewer(viewer)
         environment.close()
     return 0
+
+
+def _announce(manager, page, text: str, plain: str | None = None) -> None:
+    """``text`` as the session says it; with a page, it goes to the terminal (the researcher's) and the page
+    says ``plain`` instead (nothing when empty): the page names no task, strategy, file or command."""
+    if page is None or plain is None:
+        manager.say(text)
+        return
+    page.teacher.researcher(text)
+    if plain:
+        page.teacher.say(plain, echo=False)
 
 
 def _narrator(teacher, out, person: bool):

@@ -18,7 +18,7 @@ from dialog.commands._arguments import (
 )
 from dialog.commands._json import print_json
 from dialog.output_paths import check_writable, file_argument, make_parent, writing
-from learning.errors import OutputPathError
+from learning.errors import OutputPathError, SettingsError
 
 
 def register(commands) -> None:
@@ -43,6 +43,11 @@ def register(commands) -> None:
     condition.add_argument("--turns", type=positive_int, default=None, help="turns per episode (default 30)")
     condition.add_argument("--change-every", type=positive_int, default=None,
                            help="a new scene every N turns (default 10)")
+    condition.add_argument("--allocations", nargs="?", const="dialog/data/rl-allocations.toml", default=None,
+                           metavar="FILE.toml",
+                           help="train across allocations: each episode draws its budget, turns and scene changes "
+                                "from FILE's ranges and the policy sees them (default file: "
+                                "dialog/data/rl-allocations.toml); not with --budget, --turns, --change-every")
     condition.add_argument("--data-seed", type=seed, default=None,
                            help="the data sets' seed (default 100, which no chapter-6/7 report uses)")
     condition.add_argument("--price", type=price, default=0.0,
@@ -66,7 +71,7 @@ def run(args: argparse.Namespace) -> int:
     require_rl()
     env = {"task": args.task, "kitchen": args.kitchen, "budget": args.budget, "turns": args.turns,
            "change_every": args.change_every, "data_seed": args.data_seed,
-           "whatif": not args.no_whatif, "price": args.price}
+           "whatif": not args.no_whatif, "price": args.price, "allocations": allocations_of(args)}
     config = TrainingConfig(steps=args.steps, envs=args.envs or default_envs(), seed=args.seed,
                             env={k: v for k, v in env.items() if v is not None})
     print(f"training a questioner with masked PPO for {config.steps} steps on {config.envs} environment(s), "
@@ -78,7 +83,8 @@ def run(args: argparse.Namespace) -> int:
     with writing(args.out, "policy file"):
         save_policy(args.out, policy, "written by teachbot train-questioner: a masked PPO questioning policy\n"
                                       "run it with --strategy rl:" + str(args.out))
-    print(f"{summary['steps']} steps, {summary['episodes']} episodes in {summary['seconds']:.0f} s; "
+    print(f"{summary['steps']} steps, {summary['episodes']} episodes in {summary['seconds']:.0f} s (estimated "
+          f"{summary['estimated_seconds']:.0f} s); "
           f"{final_accuracy_words(summary)}; wrote {args.out} and {args.out.with_suffix('.npz').name}")
     if args.json:
         print_json({"out": str(args.out), **summary})
@@ -93,3 +99,18 @@ def final_accuracy_words(summary: dict) -> str:
     last = "the one training episode" if count == 1 else \
         (f"all {count} training episodes" if count == summary["episodes"] else f"the last {count} training episodes")
     return f"final accuracy of {last} {final:.3f}"
+
+
+def allocations_of(args: argparse.Namespace):
+    """``--allocations FILE``: the ranges each training episode draws from (None: one allocation)."""
+    if args.allocations is None:
+        return None
+    given = [f"--{name.replace('_', '-')}" for name in ("budget", "turns", "change_every")
+             if getattr(args, name) is not None]
+    if given:
+        raise SettingsError(f"--allocations draws each episode's allocation; {', '.join(given)} would fix it: "
+                            "give one or the other")
+    from dialog.rl.allocations import DEFAULT_FILE, load_allocations
+
+    path = DEFAULT_FILE if args.allocations == "dialog/data/rl-allocations.toml" else args.allocations
+    return load_allocations(path)

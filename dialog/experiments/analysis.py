@@ -114,7 +114,7 @@ def evaluate_findings(summaries: list[CheckpointSummary], suite: Suite) -> list[
 
     Strategies that played the same episodes (every episodes suite: same pools, seeds, scenes) are compared
     paired, by the Wilcoxon signed-rank test over the shared episodes with a cluster bootstrap interval over
-    the pools; summaries without episode keys (chapter 5's users) by Mann-Whitney U. A finding whose
+    the data seeds; summaries without episode keys (chapter 5's users) by Mann-Whitney U. A finding whose
     checkpoint lies beyond its condition's turns, or whose strategies have no results, is skipped with the reason.
     """
     lookup = {(s.condition, s.strategy): s for s in summaries}
@@ -140,14 +140,18 @@ def evaluate_findings(summaries: list[CheckpointSummary], suite: Suite) -> list[
 def compare(first: CheckpointSummary, second: CheckpointSummary, column: int,
             alternative: str = "two-sided") -> Comparison | PairedComparison:
     """``first`` against ``second`` at one checkpoint: paired over their shared episodes where both have episode
-    keys (clustered by data seed and pool), else Mann-Whitney U over the episodes that reached it."""
+    keys, else Mann-Whitney U over the episodes that reached it.
+
+    The paired interval resamples whole data seeds: the episodes of one data seed share its rendered data and
+    its one test pool, so they are one cluster (``PairedComparison.clusters`` says how many; with a single
+    data seed there is no interval). The Wilcoxon test treats the pairs as independent."""
     if first.keys and second.keys:
         mine = {key: value for key, value in zip(first.keys, first.values[:, column]) if np.isfinite(value)}
         theirs = {key: value for key, value in zip(second.keys, second.values[:, column]) if np.isfinite(value)}
         shared = [key for key in first.keys if key in mine and key in theirs]
         if shared:
             return wilcoxon_paired(first.strategy, [mine[k] for k in shared], second.strategy,
-                                   [theirs[k] for k in shared], alternative, clusters=[k[:2] for k in shared],
+                                   [theirs[k] for k in shared], alternative, clusters=[k[0] for k in shared],
                                    rng=np.random.default_rng(BOOTSTRAP_SEED))
     return mann_whitney(first.strategy, _finite(first.values[:, column]), second.strategy,
                         _finite(second.values[:, column]), alternative)

@@ -3,8 +3,8 @@
 Each data seed is a run of its own (its pools rendered from that seed, its own
 report in ``data-seed-N/``). The pooled test pairs every episode two
 strategies share across all the data seeds (unit: the episode pair; the
-interval resamples the training pools of every data seed, the independent
-units), with Holm's correction over the suite's findings as in one run.
+interval resamples whole data seeds, whose episodes share a test pool), with
+Holm's correction over the suite's findings as in one run.
 ``replication.md`` puts each finding's verdict per data seed beside the pooled one;
 ``replication.json`` holds the same numbers for ``scripts/experiments.py``, which
 writes the docs' tables from it.
@@ -20,7 +20,8 @@ import numpy as np
 from bullet_world.catalogue import load_task
 from dialog.experiments.analysis import FindingResult, evaluate_findings, group_results, summarise
 from dialog.experiments.kinds import SuiteRun
-from dialog.experiments.report import _fmt_p, questions_and_demo_share
+from dialog.experiments.quiet import quiet_cells, quiet_table
+from dialog.experiments.report import _fmt_p, interval_in_words, questions_and_demo_share, turns_used
 from dialog.experiments.suite import Suite
 from learning.significance import PairedComparison
 
@@ -47,13 +48,14 @@ def _pooled_cells(outcome: FindingResult) -> str:
     if not paired:
         return "– | –"
     pairs = min(c.n for c in paired)
-    effects = ", ".join(f"{c.b} {c.effect:+.2f} [{c.ci[0]:+.3f}, {c.ci[1]:+.3f}]" for c in paired)
+    effects = ", ".join(f"{c.b} {c.effect:+.2f} {interval_in_words(c)}" for c in paired)
     return f"{pairs} | {effects}"
 
 
 def replication_report(suite: Suite, runs: dict[int, SuiteRun], pooled: list[FindingResult], out: Path,
                        command: str) -> Path:
-    """``replication.md``: every finding's verdict on each data seed and pooled over all of them."""
+    """``replication.md``: every finding's verdict on each data seed and pooled over all of them; per condition
+    the quiet turns with budget left, pooled."""
     seeds = sorted(runs)
     episodes = sum(run.count for run in runs.values())
     lines = [f"# Replication of `{suite.name}` on data seeds {', '.join(map(str, seeds))}", "",
@@ -61,8 +63,8 @@ def replication_report(suite: Suite, runs: dict[int, SuiteRun], pooled: list[Fin
              "data seed's own report is in `data-seed-N/report.md`.", "",
              "Per data seed: the paired tests of that run, Holm-corrected over its findings. Pooled: the same "
              "tests over the episode pairs of every data seed (the unit of the test is one episode pair; the "
-             "interval is a cluster bootstrap over the training pools of all data seeds), Holm-corrected over "
-             "the findings.", "",
+             "interval is a cluster bootstrap over the data seeds, whose episodes share a test pool, with the "
+             "number of clusters beside it), Holm-corrected over the findings.", "",
              "| finding | " + " | ".join(f"data seed {s}" for s in seeds) + " | pooled | pooled pairs | "
              "pooled effect r [95 % CI of the mean difference] per comparison |",
              "|---" * (len(seeds) + 4) + "|"]
@@ -72,6 +74,11 @@ def replication_report(suite: Suite, runs: dict[int, SuiteRun], pooled: list[Fin
                  for s in seeds]
         lines.append(f"| {outcome.finding.id}: {outcome.finding.text} | " + " | ".join(cells)
                      + f" | {_verdict(outcome)} | {_pooled_cells(outcome)} |")
+    groups = group_results([result for run in runs.values() for result in run.data])
+    for condition in suite.conditions:
+        strategies = [strategy for (name, strategy) in groups if name == condition.name]
+        lines += ["", f"## Condition `{condition.name}`, pooled over the data seeds", "",
+                  *quiet_table(groups, condition.name, strategies)]
     path = out / "replication.md"
     path.write_text("\n".join(lines) + "\n", encoding="utf-8")
     return path
@@ -93,19 +100,21 @@ def _finding_cell(outcome: FindingResult) -> dict:
             "p_holm": _worst_holm_p(outcome),
             "pairs": min(getattr(c, "n", 0) for c in outcome.comparisons),
             "comparisons": [{"than": c.b, "mean": c.mean_a, "mean_than": c.mean_b,
-                             "effect_r": getattr(c, "effect", None), "ci": list(getattr(c, "ci", ()))}
+                             "effect_r": getattr(c, "effect", None), "ci": list(getattr(c, "ci", None) or ()),
+                             "clusters": getattr(c, "clusters", None)}
                             for c in outcome.comparisons]}
 
 
 def _cell(group: list[dict], summary, suite: Suite) -> dict:
     questions, share = questions_and_demo_share(group, suite)
     return {"mean": float(summary.mean[-1]), "error": float(summary.error[-1]), "episodes": len(group),
-            "questions": questions, "demo_share": share}
+            "questions": questions, "demo_share": share, **quiet_cells(group), **turns_used(group)}
 
 
 def replication_summary(suite: Suite, runs: dict[int, SuiteRun], pooled: list[FindingResult], command: str) -> dict:
     """The numbers of ``replication.md`` as data: per condition and strategy the accuracy at the condition's
-    last checkpoint (mean ± standard error over episodes), questions and demonstration share, per data seed
+    last checkpoint (mean ± standard error over episodes), questions, demonstration share and the quiet turns
+    with budget left (``quiet.quiet_cells``), per data seed
     and pooled; per finding its test per data seed and pooled."""
     results = [result for run in runs.values() for result in run.data]
     pooled_groups, pooled_summaries = group_results(results), summarise(results, suite)
@@ -126,6 +135,7 @@ def replication_summary(suite: Suite, runs: dict[int, SuiteRun], pooled: list[Fi
             rows.append(row)
         conditions.append({"name": condition.name, "budget": condition.budget, "turns": condition.turns,
                            "seconds": condition.seconds, "change_every": condition.change_every,
+                           "until_budget_spent": condition.until_budget_spent,
                            "objects_per_scene": condition.scene_size(scene_default),
                            "teacher": dict(condition.teacher), "strategies": rows})
     by_seed = {seed: {o.finding.id: o for o in run.findings} for seed, run in runs.items()}

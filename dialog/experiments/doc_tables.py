@@ -149,6 +149,8 @@ def _comment_just_above(lines: list[str], header_index: int, allowed: str) -> bo
 
 def _condition_line(condition: dict, at: int | None, axis: str) -> str:
     limit = f"{condition['seconds']:g} s" if condition.get("seconds") else f"{condition['turns']} turns"
+    if condition.get("until_budget_spent"):
+        limit = f"until the budget is spent (bound {condition['turns']} turns)"
     teacher = {k: v for k, v in condition.get("teacher", {}).items() if k != "kind"}
     told = (", teacher " + ", ".join(f"{k.replace('_', ' ')} {v}" for k, v in sorted(teacher.items()))) if teacher \
         else ""
@@ -174,18 +176,38 @@ def results_table(replication: dict) -> str:
         cells = [f"{r['pooled']['mean']:.3f} ± {r['pooled']['error']:.3f}" if (r := cell.get((c["name"], strategy)))
                  else "–" for c in conditions]
         lines.append(f"| {strategy} | " + " | ".join(cells) + " |")
-    lines += ["", "Questions asked (mean) and the share of the spent budget that went on demonstrations:", "",
+    lines += ["", "Questions asked (mean) and the share of the spent budget that went on demonstrations; where a "
+                  "condition runs until the budget is spent, the turns taken (mean / median) and how many episodes "
+                  "reached the bound:", "",
               "| strategy | " + " | ".join(c["name"] for c in conditions) + " |", "|---" * (len(conditions) + 1) + "|"]
     for strategy in strategies:
         cells = [f"{r['pooled']['questions']:.1f} q, {r['pooled']['demo_share']:.0%}"
+                 + (_turns_cell(r["pooled"]) if c.get("until_budget_spent") else "")
                  if (r := cell.get((c["name"], strategy))) else "–" for c in conditions]
         lines.append(f"| {strategy} | " + " | ".join(cells) + " |")
     return "\n".join(lines)
 
 
+def _turns_cell(pooled: dict) -> str:
+    """, 155 / 140 turns, 2 at the bound" for a condition that runs until its budget is spent."""
+    return f", {pooled['turns_mean']:.0f} / {pooled['turns_median']:g} turns, {pooled['at_bound']} at the bound"
+
+
 def _episodes_per_cell(conditions: list[dict]) -> str:
     counts = sorted({row["pooled"]["episodes"] for c in conditions for row in c["strategies"]})
     return "/".join(map(str, counts))
+
+
+def _effect_cell(comparison: dict) -> str:
+    """"vs a +0.050 [+0.010, +0.090] (5 clusters), r +0.40": the pooled mean difference, its interval with the
+    number of clusters (data seeds) it resampled where the record has it, and r."""
+    difference = f"vs {comparison['than']} {comparison['mean'] - comparison['mean_than']:+.3f}"
+    if comparison["effect_r"] is None:
+        return difference
+    clusters = comparison.get("clusters")
+    counted = "" if clusters is None else f" ({clusters} cluster{'s' if clusters != 1 else ''})"
+    interval = f" [{comparison['ci'][0]:+.3f}, {comparison['ci'][1]:+.3f}]" if comparison["ci"] else " no interval"
+    return f"{difference}{interval}{counted}, r {comparison['effect_r']:+.2f}"
 
 
 def _seed_cell(cell: dict | None) -> str:
@@ -212,16 +234,14 @@ def findings_table(replication: dict) -> str:
              "with the largest one-tailed Wilcoxon p of its comparisons (uncorrected; "
              f"{replication['datasets'] * len(replication['seeds'])} pairs a data seed). "
              "Pooled: the same paired tests over every data seed's episodes, Holm-corrected over the suite's "
-             "findings, with each comparison's mean difference, its 95 % cluster-bootstrap interval and the "
-             "rank-biserial r.", "",
+             "findings, with each comparison's mean difference, its 95 % cluster-bootstrap interval (whole data "
+             "seeds resampled, their number beside it) and the rank-biserial r.", "",
              "| finding | " + " | ".join(f"data seed {s}" for s in seeds)
              + " | pooled pairs | pooled effects | Holm p | holds? |", "|---" * (len(seeds) + 5) + "|"]
     for finding in replication["findings"]:
         pooled = finding["pooled"]
         if pooled["tested"]:
-            effects = "; ".join(f"vs {c['than']} {c['mean'] - c['mean_than']:+.3f} [{c['ci'][0]:+.3f}, "
-                                f"{c['ci'][1]:+.3f}], r {c['effect_r']:+.2f}" if c["ci"] and c["effect_r"] is not None
-                                else f"vs {c['than']} {c['mean'] - c['mean_than']:+.3f}" for c in pooled["comparisons"])
+            effects = "; ".join(_effect_cell(c) for c in pooled["comparisons"])
             tail = f"{pooled['pairs']} | {effects} | {format_p(pooled['p_holm'])} | {finding_verdict(pooled)}"
         else:
             tail = f"– | {pooled['why']} | – | not tested"

@@ -58,6 +58,7 @@ class EpisodeSpec:
         return EpisodeSettings(task=self.task, kitchen=self.kitchen, strategy=self.strategy, seed=self.episode_seed,
                                turns=condition.turns, budget=condition.budget, change_every=condition.change_every,
                                costs=dict(self.costs), seconds=condition.seconds,
+                               until_budget_spent=condition.until_budget_spent,
                                weights=None if self.weights is None else self.weights.record())
 
 
@@ -78,7 +79,8 @@ def suite_teacher(options: dict, rng: np.random.Generator, clock=None, answer_de
 
 
 def run_episode(spec: EpisodeSpec, strategy: Strategy | None = None) -> dict:
-    """Run one episode; returns its spec, per-turn series, final accuracy, wall time and CPU time.
+    """Run one episode; returns its spec, per-turn series, final accuracy, the per-turn utility terms of the
+    strategy's decisions (``decision_terms``, see ``TurnRecords``), wall time and CPU time.
 
     ``strategy`` (default: the one ``spec`` names) is an already built strategy, e.g. IRL's MaxEnt policy,
     which the caller can read after the episode (dialog.experiments.irl_rollouts)."""
@@ -106,18 +108,28 @@ def _run_episode(spec: EpisodeSpec, strategy: Strategy | None = None) -> dict:
                                say=lambda _: None, clock=timing.clock, observers=(turns,)).run()
     series = series_from_transcript(turns.records)
     return {"spec": asdict(spec), "label": spec.label, "series": series, "accuracy": result.accuracy,
-            "seconds": time.perf_counter() - started, "cpu_seconds": time.process_time() - started_cpu}
+            "decision_terms": turns.terms, "ended": result.ended, "seconds": time.perf_counter() - started,
+            "cpu_seconds": time.process_time() - started_cpu}
 
 
 class TurnRecords:
     """An observer keeping every turn record as the manager wrote it to the transcript, so that the series are
-    built from the records in memory instead of reading the file back (JSON keeps every value exactly)."""
+    built from the records in memory instead of reading the file back (JSON keeps every value exactly), and
+    beside each the strategy's utility terms of that turn's decision (DT's ``Decision.terms``; {} for a strategy
+    without them). The terms stay out of the transcript and the series: the reports read them from memory."""
 
     def __init__(self) -> None:
         self.records: list[dict] = []
+        self.terms: list[dict[str, float]] = []
+        self._pending: dict[str, float] = {}
+
+    def on_decision(self, decision) -> None:
+        self._pending = dict(decision.terms)
 
     def on_turn(self, record: dict, scene) -> None:
         self.records.append(record)
+        self.terms.append(self._pending)
+        self._pending = {}
 
 
 def series_from_transcript(records: list[dict]) -> dict[str, list]:

@@ -10,19 +10,22 @@ import numpy as np
 from bullet_world.catalogue import load_task
 from dialog.experiments.analysis import CheckpointSummary, FindingResult, group_results, pairwise
 from dialog.experiments.episodes import SERIES
+from dialog.experiments.quiet import quiet_columns, quiet_table
 from dialog.experiments.suite import Suite
 from learning.significance import PairedComparison
 from learning.strategies import file_label
 
 
 def write_episode_csvs(results: list[dict], out: Path) -> Path:
-    """One CSV per episode (turn, accuracy, questions by type, budget) and one summary row per episode."""
+    """One CSV per episode (turn, accuracy, questions by type, budget) and one summary row per episode, ending
+    with its quiet turns with budget left and DT's mean terms on them (``quiet.quiet_columns``)."""
     summary_path = out / "episodes.csv"
     out.mkdir(parents=True, exist_ok=True)
     with open(summary_path, "w", newline="") as summary_file:
         summary = csv.writer(summary_file)
         summary.writerow(["condition", "strategy", "dataset", "seed", "accuracy", "questions", "label", "demo",
-                          "feature", "spent", "seconds", "csv"])
+                          "feature", "spent", "seconds", "csv", "quiet_with_budget_left", "quiet_terms", "turns",
+                          "ended"])
         for result in results:
             spec, series = result["spec"], result["series"]
             path = out / "episodes" / spec["condition"]["name"] / f"{file_label(spec['strategy'])}" \
@@ -35,7 +38,8 @@ def write_episode_csvs(results: list[dict], out: Path) -> Path:
             summary.writerow([spec["condition"]["name"], spec["strategy"], spec["dataset"], spec["seed"],
                               f"{result['accuracy']:.4f}", series["questions"][-1], series["label"][-1],
                               series["demo"][-1], series["feature"][-1], series["spent"][-1],
-                              f"{result['seconds']:.2f}", path.relative_to(out)])
+                              f"{result['seconds']:.2f}", path.relative_to(out), *quiet_columns(result),
+                              len(series["turn"]), result.get("ended", "")])
     return summary_path
 
 
@@ -47,26 +51,44 @@ def questions_and_demo_share(group: list[dict], suite: Suite) -> tuple[float, fl
     return questions, share
 
 
+def turns_used(group: list[dict]) -> dict:
+    """Turns the episodes of a group played: mean, median, and how many ended at the safety bound (chapter-6
+    conditions that run until the budget is spent; ``EpisodeResult.ended``)."""
+    turns = [len(r["series"]["turn"]) for r in group]
+    return {"turns_mean": float(np.mean(turns)), "turns_median": float(np.median(turns)),
+            "at_bound": sum(r.get("ended") == "bound" for r in group)}
+
+
+def until_budget_spent_in_words(condition) -> str:
+    """How a condition that ends on its budget reads in a heading (the bound in turns)."""
+    return f"until the budget is spent (bound {condition.turns} turns), "
+
+
 def _fmt_p(p: float) -> str:
     """A p value: 3 significant digits, scientific below 1e-4 (one format for the whole column)."""
     return f"{p:.3g}" if p >= 1e-4 else f"{p:.1e}"
 
 
 PLANNED_NOTE = ("Every strategy played the same episodes (the same pools, seeds and scenes), so each comparison is "
-                "paired: the Wilcoxon signed-rank test over the shared episodes (n pairs), the matched-pairs "
-                "rank-biserial r, the median difference, and a 95 % interval of the mean difference from a cluster "
-                "bootstrap over the training pools and data seeds (the independent units; episodes of one pool "
-                "share its data). A finding holds when every one of its comparisons is significant after Holm's "
-                "correction over all the comparisons in this table.")
+                "paired: the Wilcoxon signed-rank test over the shared episodes (n pairs, treated as independent), "
+                "the matched-pairs rank-biserial r, the median difference, and a 95 % interval of the mean "
+                "difference from a cluster bootstrap over the data seeds (the episodes of one data seed share its "
+                "rendered data and test pool, so a data seed is one cluster; the number of clusters stands beside "
+                "each interval, and with one data seed there is no interval). A finding holds when every one of "
+                "its comparisons is significant after Holm's correction over all the comparisons in this table.")
 
 
 def _paired_cells(c) -> str:
     """n | median diff | r | CI | W for a paired comparison; the unpaired Mann-Whitney's n and U otherwise."""
     if isinstance(c, PairedComparison):
-        low, high = c.ci
-        return (f"{c.n} | {c.median_difference:+.3f} | {c.effect:+.2f} | [{low:+.3f}, {high:+.3f}] "
-                f"({c.clusters} clusters) | {c.statistic:.1f}")
+        return f"{c.n} | {c.median_difference:+.3f} | {c.effect:+.2f} | {interval_in_words(c)} | {c.statistic:.1f}"
     return f"{c.n_a} + {c.n_b} | – | – | – | U {c.u:.1f}"
+
+
+def interval_in_words(c: PairedComparison) -> str:
+    """"[+0.010, +0.050] (5 clusters)", or "none (1 cluster)" when a single cluster leaves nothing to resample."""
+    clusters = f"({c.clusters} cluster{'s' if c.clusters != 1 else ''})"
+    return f"none {clusters}" if c.ci is None else f"[{c.ci[0]:+.3f}, {c.ci[1]:+.3f}] {clusters}"
 
 
 def comparison_table(comparisons: list, at: str) -> list[str]:
@@ -125,8 +147,9 @@ def teacher_in_words(teacher: dict) -> str:
 
 def markdown_report(suite: Suite, results: list[dict], summaries: list[CheckpointSummary],
                     findings: list[FindingResult], seconds: float, out: Path, figures: list[Path]) -> Path:
-    """``report.md``: per condition the figures, accuracy at the checkpoints inside its turns, pairwise
-    tests at its last checkpoint; then every finding, tested or skipped with the reason."""
+    """``report.md``: per condition the figures, accuracy at the checkpoints inside its turns, the quiet turns
+    with budget left (``quiet.py``), pairwise tests at its last checkpoint; then every finding, tested or
+    skipped with the reason."""
     axis_name = {"questions": "questions asked", "seconds": "seconds"}.get(suite.axis, "turns")
     lines = [f"# Regression report: {suite.name}", "", suite.description, "",
              f"- task `{suite.task}`, kitchen `{suite.kitchen}`, {suite.datasets} training data sets, "
@@ -144,6 +167,7 @@ def markdown_report(suite: Suite, results: list[dict], summaries: list[Checkpoin
     for condition in suite.conditions:
         embodied = "" if condition.seconds is None else \
             f"embodied costs, {condition.seconds:g} s (at most {condition.turns} turns), "
+        embodied = until_budget_spent_in_words(condition) if condition.until_budget_spent else embodied
         lines += [f"## Condition `{condition.name}`: budget {condition.budget:g}, "
                   f"{embodied or f'{condition.turns} turns, '}a new scene every {condition.change_every} turns, "
                   f"{condition.scene_size(scene_default)} objects a scene"
@@ -160,7 +184,7 @@ def markdown_report(suite: Suite, results: list[dict], summaries: list[Checkpoin
                       f"{condition.turns} turns.", ""]
             continue
         note = f" (checkpoints {left_out} lie beyond its {condition.turns} turns)" if left_out else ""
-        used = [] if condition.seconds is None else ["used"]
+        used = ["used"] if condition.seconds is not None or condition.until_budget_spent else []
         lines += [f"Mean held-out accuracy ± standard error after this many {axis_name}{note}:", "",
                   "| strategy | " + " | ".join([*(f"after {c} {axis_name}" for c in checkpoints), *used])
                   + " | questions | demo share |", "|---" * (len(checkpoints) + 3 + len(used)) + "|"]
@@ -171,7 +195,16 @@ def markdown_report(suite: Suite, results: list[dict], summaries: list[Checkpoin
             if condition.seconds is not None:  # embodied costs: how many turns and seconds the episodes took
                 turns = np.mean([r["series"]["turn"][-1] for r in group])
                 cells += f" | {turns:.1f} turns, {np.mean([r['series']['seconds'][-1] for r in group]):.0f} s"
+            elif condition.until_budget_spent:  # the thesis's ending: turns taken (mean / median), at the bound
+                taken = turns_used(group)
+                cells += f" | {taken['turns_mean']:.1f} / {taken['turns_median']:g} turns, {taken['at_bound']} of " \
+                         f"{len(group)} at the bound"
             lines.append(f"| {summary.strategy} | {cells} | {questions:.1f} | {demo_cost:.0%} |")
+        if condition.until_budget_spent:
+            lines += ["", f"Episodes run until the budget is spent; \"used\" gives the turns they took (mean / "
+                          f"median), and how many reached the bound of {condition.turns} turns with budget left "
+                          "(scored where they stopped)."]
+        lines += ["", *quiet_table(groups, condition.name, [summary.strategy for summary in rows])]
         column = len(checkpoints) - 1
         lines += ["", f"Exploratory (not corrected, not planned): two-sided tests between every pair of strategies "
                       f"after {checkpoints[column]} {axis_name}.", ""]

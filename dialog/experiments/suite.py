@@ -11,9 +11,10 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from dialog.experiments.registry import kind_names
+from dialog.settings import check_budget_pays_for_a_question
 from learning import datafiles
 from learning.actions import DEFAULT_COSTS
-from learning.datafiles import check_keys, integer, number, numbers, read_toml, section, tables, text, texts
+from learning.datafiles import check_keys, flag, integer, number, numbers, read_toml, section, tables, text, texts
 from learning.errors import DataFileError, SettingsError, did_you_mean
 from learning.limits import check_limit, maximum
 from learning.significance import ALTERNATIVES
@@ -27,7 +28,8 @@ SUITE_FIELDS = ("name", "description", "analysis", "kind", "task", "kitchen", "s
 CONDITION_FIELDS = ("name", "budget", "turns", "change_every")
 # seconds: embodied costs' time allocation (turns is then the cap); objects_per_scene: the scene size (thesis §6.5)
 # teacher: the scripted teacher's options for this condition, over the suite's [teacher] (a sweep of them)
-CONDITION_OPTIONAL = ("seconds", "objects_per_scene", "teacher")
+# until_budget_spent: the thesis's chapter-6 ending (the episode ends once the budget is spent; turns is the bound)
+CONDITION_OPTIONAL = ("seconds", "objects_per_scene", "teacher", "until_budget_spent")
 FINDING_FIELDS = ("id", "text", "condition", "at", "better", "than", "alternative", "than_at", "margin")
 TEACHER_KINDS = ("scripted", "oracle")
 TEACHER_RATES = ("mislabel_rate", "dont_know_rate", "feature_quality", "feature_recall", "feature_noise",
@@ -50,6 +52,7 @@ class Condition:
     seconds: float | None = None  # embodied costs (thesis §8.2.2): the allocation in seconds; turns is the cap
     objects_per_scene: int | None = None  # scene size of the episodes (None: the task's interactive default)
     teacher: tuple = ()  # ((option, value), ...): the scripted teacher's options here, over the suite's [teacher]
+    until_budget_spent: bool = False  # end once the budget is spent (thesis ch. 6); ``turns`` is the safety bound
 
     def scene_size(self, task_default: int) -> int:
         """How many objects each scene of this condition holds."""
@@ -198,6 +201,12 @@ def _suite(table: dict, where: str, known_strategies) -> Suite:
         raise SuiteError(f"{where}: condition names must be unique, got {names}")
     if kind == "recipes" and "data_seed" in table:
         raise SuiteError(f"{where}: 'data_seed' is not accepted in a suite of kind 'recipes' (it renders no data sets)")
+    costs = _costs(table, where)
+    for condition in (c for c in conditions if c.until_budget_spent):
+        try:
+            check_budget_pays_for_a_question(condition.budget, costs or DEFAULT_COSTS)
+        except SettingsError as error:
+            raise SuiteError(f"{where} condition '{condition.name}': {error}") from None
     findings = tuple(_finding(f, kind, strategies, names, f"{where} finding {i + 1}")
                      for i, f in enumerate(tables(table, "finding", where, [])))
     seeds = numbers(table, "seeds", where, (0,), whole=True, low=0)
@@ -211,7 +220,7 @@ def _suite(table: dict, where: str, known_strategies) -> Suite:
         strategies=strategies, conditions=conditions,
         datasets=integer(table, "datasets", where, 5, low=1, high=maximum("datasets")),
         seeds=seeds, checkpoints=checkpoints,
-        axis=text(table, "axis", where, "questions", choices=AXES), costs=_costs(table, where),
+        axis=text(table, "axis", where, "questions", choices=AXES), costs=costs,
         teacher=_teacher(table, where), findings=findings, options=_options(table, kind, where), path=where,
         dataset=_plan(table, where), analysis=text(table, "analysis", where, "", nonempty=False),
         data_seed=integer(table, "data_seed", where, 0, low=0),
@@ -227,7 +236,16 @@ def _condition(table: dict, where: str, objects_per_scene: int | None = None) ->
                      integer(table, "change_every", where, low=1),
                      number(table, "seconds", where, None, above=0.0, high=maximum("seconds")),
                      integer(table, "objects_per_scene", where, objects_per_scene, low=1),
-                     tuple(sorted(_teacher(table, where).items())))
+                     tuple(sorted(_teacher(table, where).items())), _until_budget_spent(table, where))
+
+
+def _until_budget_spent(table: dict, where: str) -> bool:
+    """A condition's ``until_budget_spent``: true or false (default false); not with a seconds allocation."""
+    value = flag(table, "until_budget_spent", where, False)
+    if value and "seconds" in table:
+        raise SuiteError(f"{where}: 'until_budget_spent' ends an episode on its budget, 'seconds' on its time; "
+                         "give one of them")
+    return value
 
 
 def _check_seeds(seeds, label: str, error: type[DataFileError] | type[SettingsError]) -> None:

@@ -50,6 +50,7 @@ from dialog.experiments.irl_rollouts import training_condition
 from dialog.experiments.pools import PoolEnvironment, load_pools
 from dialog.experiments.suite import teacher_options
 from dialog.manager import DialogManager, episode_generators
+from dialog.rl.allocations import Allocation, ranges_from
 from dialog.settings import EpisodeSettings, check_costs
 from dialog.transcripts.jsonl import MemoryTranscript, TranscriptWriter
 from learning.actions import NoQuery
@@ -125,9 +126,15 @@ class QuestioningEnv(gym.Env):
                  turns: int | None = None, change_every: int | None = None, costs: dict | None = None,
                  teacher: dict | None = None, data_seed: int | None = None, datasets: int | None = None,
                  whatif: bool = True, price: float = 0.0, transcript: str | None = None,
-                 render_mode: str | None = None):
+                 render_mode: str | None = None, allocations=None):
         self.settings = QuestioningSettings(task, kitchen, budget, turns, change_every, costs, teacher, data_seed,
                                             datasets).resolved()
+        self.allocations = None if allocations is None else ranges_from(allocations)
+        given = [name for name, value in (("budget", budget), ("turns", turns), ("change_every", change_every))
+                 if value is not None]
+        if self.allocations is not None and given:
+            raise SettingsError(f"give either allocations (each episode draws its own) or {', '.join(given)} "
+                                "(one allocation for every episode), not both")
         if not isinstance(whatif, bool | np.bool_):
             raise SettingsError(f"whatif must be True or False (each slot's expected features in the observation), "
                                 f"got {whatif!r}")
@@ -141,7 +148,7 @@ class QuestioningEnv(gym.Env):
         s = self.settings
         self.pools = load_pools(s.task, s.kitchen, s.datasets, data_seed=s.data_seed)
         self.layout = ObservationLayout(tuple(self.pools.task.concepts), self.pools.task.objects_per_scene,
-                                        bool(whatif))
+                                        bool(whatif), allocation=self.allocations is not None)
         self.price, self.transcript_path, self.render_mode = float(price), transcript, render_mode
         self.engine = make_engine("fast")
         self.action_space = spaces.Discrete(self.layout.n_actions)
@@ -153,6 +160,7 @@ class QuestioningEnv(gym.Env):
         self._last: dict = {}
         self._ended = False
         self.episode_seed: int | None = None
+        self.allocation: Allocation | None = None
 
     # -- Gymnasium ------------------------------------------------------------------------
     def reset(self, *, seed: int | None = None, options: dict | None = None):
@@ -165,12 +173,16 @@ class QuestioningEnv(gym.Env):
             seed = int(self.np_random.integers(SEED_LIMIT))
         s = self.settings
         self.episode_seed = int(seed)
-        scenes = -(-s.turns // s.change_every)
+        self.allocation = (Allocation(float(s.budget), s.turns, s.change_every) if self.allocations is None
+                           else self.allocations.draw(self.episode_seed))
+        a = self.allocation
+        scenes = -(-a.turns // a.change_every)
         dataset = self.episode_seed % s.datasets if dataset is None else dataset
         world = PoolEnvironment(self.pools.train[dataset], self.pools.test, self.pools.task, scenes)
         rngs = episode_generators(self.episode_seed)
         settings = EpisodeSettings(task=s.task, kitchen=s.kitchen, strategy=AgentChooses.name, seed=self.episode_seed,
-                                   turns=s.turns, budget=s.budget, change_every=s.change_every, costs=dict(s.costs))
+                                   turns=a.turns, budget=s.budget if self.allocations is None else a.budget,
+                                   change_every=a.change_every, costs=dict(s.costs))
         transcript = MemoryTranscript() if self.transcript_path is None else TranscriptWriter(self.transcript_path)
         self.manager = build_episode(settings, world, suite_teacher(dict(s.teacher), rngs["teacher"]), transcript,
                                      strategy=AgentChooses(), rngs=rngs, say=lambda _: None,
@@ -261,7 +273,7 @@ class QuestioningEnv(gym.Env):
         manager, observation = self._running()
         return {"action_mask": observation.mask.copy(), "accuracy": self._accuracy, "turn": manager.turn,
                 "spent": manager.state.spent, "budget": manager.state.budget, "invalid_action": invalid,
-                "features": FEATURE_NAMES}
+                "features": FEATURE_NAMES, "allocation": self.allocation.record()}
 
 
 if ENV_ID not in gym.registry:

@@ -26,6 +26,7 @@ from learning.rl.observation import ObservationLayout
 from learning.rl.policy_file import QuestionerPolicy
 
 HIDDEN = (64, 64)
+ESTIMATE_EPISODES, ESTIMATE_TURNS = 2, 60  # timed before training for the time estimate: at least this many of each
 
 
 @dataclass(frozen=True)
@@ -87,11 +88,19 @@ class _Progress:
     def __enter__(self):
         if self.enabled:
             from rich.console import Console
-            from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+            from rich.progress import (
+                BarColumn,
+                MofNCompleteColumn,
+                Progress,
+                TextColumn,
+                TimeElapsedColumn,
+                TimeRemainingColumn,
+            )
 
             console = Console(file=sys.stderr)
             self._bar = Progress(TextColumn("training steps"), BarColumn(), MofNCompleteColumn(),
-                                 TimeElapsedColumn(), TextColumn("{task.description}"), console=console,
+                                 TimeElapsedColumn(), TextColumn("left"), TimeRemainingColumn(),
+                                 TextColumn("{task.description}"), console=console,
                                  transient=not console.is_terminal)
             self._bar.start()
             self._task = self._bar.add_task("", total=self.total)
@@ -128,7 +137,15 @@ def train(config: TrainingConfig, progress: bool = True, provenance: dict | None
     say("loading the training data sets (rendered in the simulated kitchen on the first run, then cached)...")
     probe = make_env(config.env)()  # validates the options here, once, and renders the data sets if needed
     layout = probe.layout
+    loading = time.perf_counter() - started  # the training environments load the same data sets again
+    per_turn = seconds_per_turn(probe, config.seed)
     probe.close()
+    so_far = time.perf_counter() - started
+    estimate = so_far + loading + per_turn * config.steps / min(config.envs, os.cpu_count() or 1)
+    say(f"this will take about {_duration(estimate)} in all: {so_far:.0f} s so far, {loading:.0f} s to start the "
+        "environments, then "
+        f"{config.steps} steps at {per_turn * 1000:.0f} ms per turn over {config.envs} environment(s) (timed on "
+        f"{ESTIMATE_EPISODES}+ whole episodes of random questions)")
     say(f"starting {config.envs} environment{'s' if config.envs > 1 else ''}"
         f"{' in worker processes' if config.envs > 1 else ''}, then training...")
     vec_cls = SubprocVecEnv if config.envs > 1 else DummyVecEnv
@@ -154,12 +171,34 @@ def train(config: TrainingConfig, progress: bool = True, provenance: dict | None
     seconds = time.perf_counter() - started
     recent = tracker.accuracies[-50:]
     summary = {"steps": int(model.num_timesteps), "episodes": tracker.episodes, "seconds": round(seconds, 1),
+               "estimated_seconds": round(estimate, 1),
                "final_accuracy_last_50": round(float(np.mean(recent)), 4) if recent else None,
                "final_accuracy_episodes": len(recent)}
     record = {**(provenance or {}), **{f"ppo_{k}": v for k, v in asdict(config).items() if k != "env"},
               **{f"env_{k}": _plain(v) for k, v in probe.settings.__dict__.items()},
+              **(probe.allocations.record() if probe.allocations is not None else {}),
               "algorithm": "MaskablePPO (sb3-contrib)", "hidden_layers": list(HIDDEN), **summary}
     return actor_policy(model, layout, record), summary
+
+
+def seconds_per_turn(env, seed: int, episodes: int = ESTIMATE_EPISODES, turns: int = ESTIMATE_TURNS) -> float:
+    """Wall seconds per environment step over whole episodes of uniformly random candidate slots (what an
+    untrained masked policy plays): at least ``episodes`` episodes and ``turns`` turns, resets included, since a
+    turn's cost grows with the examples learned and so with the episode's allocation and its progress."""
+    rng = np.random.default_rng(seed)
+    started, played, ended = time.perf_counter(), 0, 0
+    while ended < episodes or played < turns:
+        _, info = env.reset(seed=seed + ended)
+        terminated = False
+        while not terminated:
+            _, _, terminated, _, info = env.step(int(rng.choice(np.flatnonzero(info["action_mask"]))))
+            played += 1
+        ended += 1
+    return (time.perf_counter() - started) / played
+
+
+def _duration(seconds: float) -> str:
+    return f"{seconds:.0f} s" if seconds < 120 else f"{seconds / 60:.0f} min"
 
 
 def actor_policy(model, layout: ObservationLayout, provenance: dict) -> QuestionerPolicy:

@@ -258,6 +258,8 @@ class ParticipantRun:
                                             input_stream=self.input_stream, output_stream=self.out,
                                             observers=observers, lock=lock,
                                             teacher=None if self.page is None else self.page.teacher)
+            if self.page is not None and records:  # a resumed session: the page shows the conversation so far
+                self.page.teacher.recall(records, environment.concepts)
             if person and self.page is None:
                 manager.teacher.reader = self.reader  # one reader for the whole run: nothing typed is lost
                 manager.teacher.show_budget = self.show_conditions

@@ -82,7 +82,7 @@ def converse(teacher: Teacher, prompt: Prompt, parser: AnswerParser, clock) -> O
         if reading.kind == "more":  # a group of the feature list opened: a reply, the question stays open
             teacher.tell(reading.message)
         elif reading.kind == "help":
-            teacher.tell(help_text(prompt) if not choices else
+            teacher.tell(getattr(teacher, "help_for", help_text)(prompt) if not choices else
                          "Type the number of the one you meant, or 'no' to answer the question again.")
         elif reading.kind == "why":
             teacher.tell(f"Why I ask: {prompt.explanation}" if prompt.explanation else "I have no reason to give.")

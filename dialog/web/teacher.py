@@ -18,7 +18,8 @@ import threading
 
 import numpy as np
 
-from dialog.language.questions import Prompt, help_text
+from dialog.language.questions import Prompt
+from dialog.web import words
 from dialog.web.messages import Asked, PageAnswer, decode, read_message, read_screen
 from learning.errors import MessageError
 
@@ -93,7 +94,7 @@ class WebTeacher:
             self.current = {
                 "id": self._question, "turn": prompt.turn, "turns": prompt.turns,
                 "budget_left": prompt.budget_left if self.show_budget else None, "expects": prompt.expects,
-                "text": prompt.text,
+                "text": words.question_text(prompt.expects, prompt.text, prompt.concepts),
                 "concepts": list(prompt.concepts), "objects": n_objects,
                 "object": None if prompt.object_index is None else prompt.object_index + 1,
                 "picture": bool(prompt.picture), "details": [line for line in prompt.details
@@ -101,10 +102,10 @@ class WebTeacher:
                 "features": _tree_rows(tree) if tree is not None else [],
                 "seconds_left": None if prompt.deadline is None or self.clock is None
                 else round(max(0.0, prompt.deadline - self.clock.now()), 1),
-                "help": help_text(prompt),
+                "help": words.help_text(prompt),
             }
             question = dict(self.current)
-        self._note("robot", prompt.text)
+        self._note("robot", question["text"])
         self._post({"type": "question", "question": question})
 
     def listen(self, prompt: Prompt, deadline: float | None) -> str | None:
@@ -146,11 +147,43 @@ class WebTeacher:
         """A scripted teacher's answer, shown as the teacher's line ("Teacher: ", not the person's "You: ")."""
         self._note("scripted", text)
 
+    def help_for(self, prompt: Prompt) -> str:
+        """The help the page gives: its buttons, not the terminal's typed commands."""
+        return words.help_text(prompt)
+
+    def budget_changed(self, budget_left: float) -> None:
+        """An undo gave budget back: the open question's budget line says so at once."""
+        with self._lock:
+            if self.current is None or not self.show_budget:
+                return
+            self.current["budget_left"] = budget_left
+            question = self.current["id"]
+        self._post({"type": "budget", "question": question, "budget_left": budget_left})
+
+    def recall(self, records: list[dict], concepts) -> None:
+        """A resumed session's earlier turns as the page's conversation so far: each question and its answers."""
+        for record in records:
+            action = record.get("action") or {}
+            if action.get("kind") in (None, "none") or not record.get("question"):
+                continue
+            answer = record.get("answer") or {}
+            self._note("robot", words.question_text(action["kind"], record["question"], concepts))
+            for line in answer.get("lines") or [answer.get("raw") or ""]:
+                self._note("teacher", line)
+
+    def researcher(self, text: str) -> None:
+        """A line for the researcher only (the strategy, files, the command that continues): the terminal."""
+        if self.echo is not None:
+            print(text, file=self.echo, flush=True)
+
     def answer_channel(self) -> dict:
         last = self._last
         return {"channel": last.channel, "page_seconds": last.page_seconds} if last else {"channel": "typed"}
 
     def tell(self, text: str) -> None:
+        shown = self._shown
+        if shown is not None and shown.expects == "feature" and shown.text in text:  # "Now: ...", "All right. ..."
+            text = text.replace(shown.text, words.question_text("feature", shown.text, shown.concepts))
         self._note("robot", text)
 
     def say(self, text: str, echo: bool = True) -> None:
@@ -187,10 +220,11 @@ class WebTeacher:
 
     def ask_screen(self, title: str, text: str = "", button: str = "Continue", items: list | None = None) -> list:
         """Show a study screen (instructions, a pause, the questionnaire) and wait for its form: the values of
-        its ``items`` (None where left out)."""
+        its ``items`` (None where left out). A terminal's "Press Enter" in ``text`` names the button instead."""
         with self._lock:
             self._question += 1
-            self._screen = {"id": self._question, "title": title, "text": text, "button": button,
+            self._screen = {"id": self._question, "title": title, "text": words.for_page(text, button),
+                            "button": button,
                             "items": list(items or [])}
             self.current, self._asked = None, None
             screen = dict(self._screen)
@@ -244,14 +278,18 @@ class WebTeacher:
 
 
 def _tree_rows(tree) -> list[dict]:
-    """The feature tree as rows for checkboxes: number, name, description, depth, whether a group."""
+    """The feature tree as rows for checkboxes: number, name, the words the page shows (a group's from
+    dialog/data/feature-groups.toml, a feature's own description), depth, whether a group."""
     rows: list[dict] = []
 
-    def walk(nodes, depth: int) -> None:
+    def walk(nodes, depth: int, path: str) -> None:
         for node in nodes:
-            rows.append({"number": node.number, "name": node.name, "description": node.description,
-                         "depth": depth, "group": node.feature is None})
-            walk(node.children, depth + 1)
+            group = node.feature is None
+            here = f"{path}/{node.name}" if path else node.name
+            rows.append({"number": node.number, "name": node.name,
+                         "label": words.group_label(here) if group else node.description or node.name,
+                         "depth": depth, "group": group})
+            walk(node.children, depth + 1, here)
 
-    walk(tree.roots, 0)
+    walk(tree.roots, 0, "")
     return rows

@@ -12,8 +12,9 @@ utility U(s) = w . phi(s) the expected utility is EU(a) = w . E[phi(s') | a].
   advances one turn whatever is done. A query's next state has spent + cost and t_NQ = 0; NoQuery's
   has spent (+ its cost, 0 by default), t_NQ = min(q + 1, W) / W for a quiet run q now and window W,
   and the learning features of the current classifiers (nothing is learned by staying quiet).
-  "argmax over all rows" is the thesis rule "take a* only if EU(a*) > EU(no query)"; ties go to no
-  query. ``current`` keeps phi(s) itself, which no longer equals any row.
+  "argmax over all rows" is eq. 7.1's rule, "take a* only if EU(a*) > EU(no query)"; ties go to no
+  query. (The thesis's chapter-6 rule compares with U(s) instead: the same only when every environment
+  feature weighs 0; docs/strategies.md.) ``current`` keeps phi(s) itself, which no longer equals any row.
 
 Candidates, in this fixed order: a DemoQuery per concept (state.concepts
 order; not for a concept the teacher could not show in this scene), a

@@ -30,8 +30,10 @@ from learning.limits import check_limit
 WEIGHTS_DIRECTORY = Path(__file__).resolve().parent / "presets"
 # dt-task-env weighs the seven and the expert-habit features (issue 27); dt-task-env-thesis is the thesis's
 # seven-feature DT-task-env (the earlier trajectory fit); the last two are issue 27's pre-registered ablations
-# (docs/irl.md).
-PRESETS = ("dt", "dt-iros", "dt-task", "dt-task-env", "dt-task-env-thesis", "dt-task-env-no-env", "dt-task-habits")
+# (docs/irl.md); dt-iros-v1 and dt-task-v1 keep the hand-set weights of dt-iros and dt-task from before issue 39's
+# calibration rule (docs/calibration.md).
+PRESETS = ("dt", "dt-iros", "dt-task", "dt-iros-v1", "dt-task-v1",
+           "dt-task-env", "dt-task-env-thesis", "dt-task-env-no-env", "dt-task-habits")
 
 
 def weight_vector(weights: Mapping[str, float] | Sequence[float] | np.ndarray, source: str = "weights") -> np.ndarray:

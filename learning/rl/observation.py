@@ -17,6 +17,8 @@ and the observation, all in [0, 1]:
                               state (eq. 6.3, 7.1; the fast what-if engine), |slots| x 7 values,
                               zeros where the slot is not a candidate (``whatif=False`` leaves them out)
     mask                      1 where the slot is a candidate this turn (affordable, present), |slots| values
+    allocation                (``allocation=True`` only: a policy trained across allocations, issue 40) the
+                              episode's allocation, 4 values (``allocation_features``)
 
 The same encoding serves the Gymnasium environment (dialog/rl/gym_env.py) and the
 strategy that runs a trained policy (learning/strategies/rl_questioner.py), so a
@@ -36,6 +38,20 @@ from learning.errors import SettingsError
 from learning.whatif import WhatIfEngine, make_engine
 
 N_FEATURES = len(FEATURE_NAMES)
+ALLOCATION_NAMES = ("log_budget", "log_turns", "scene_share", "questions_per_turn")
+ALLOCATION_SCALE = 1000.0  # budgets and turns are encoded as log(1 + x) / log(1 + ALLOCATION_SCALE), clipped to 1
+
+
+def allocation_features(progress) -> np.ndarray:
+    """The time and budget allocation of an episode as 4 numbers in [0, 1] (beyond the thesis: phi(s) of eq. 7.2
+    holds only the fractions spent, so a policy trained on one allocation cannot tell another from it):
+    log(1 + B) and log(1 + T) over log(1 + 1000); the share of the episode one scene lasts (change_every / T);
+    and how many questions of the cheapest kind the budget buys per turn, min(1, B / c_min / T)."""
+    paid = [cost for kind, cost in progress.costs.items() if kind != "none" and cost > 0]
+    questions = progress.budget / min(paid) if paid else float(progress.turns)
+    scale = np.log1p(ALLOCATION_SCALE)
+    return np.clip(np.array([np.log1p(progress.budget) / scale, np.log1p(progress.turns) / scale,
+                             progress.change_every / progress.turns, questions / progress.turns]), 0.0, 1.0)
 
 
 @dataclass(frozen=True)
@@ -54,6 +70,7 @@ class ObservationLayout:
     concepts: tuple[str, ...]
     max_objects: int
     whatif: bool = True
+    allocation: bool = False
 
     def __post_init__(self) -> None:
         if not self.concepts or len(set(self.concepts)) != len(self.concepts):
@@ -75,7 +92,8 @@ class ObservationLayout:
     @property
     def size(self) -> int:
         """Length of the observation vector."""
-        return N_FEATURES + (self.n_actions * N_FEATURES if self.whatif else 0) + self.n_actions
+        return (N_FEATURES + (self.n_actions * N_FEATURES if self.whatif else 0) + self.n_actions
+                + (len(ALLOCATION_NAMES) if self.allocation else 0))
 
     def slot_of(self, action: Action) -> int:
         if action.kind == "none":
@@ -113,10 +131,15 @@ class ObservationLayout:
                 rows[self.slot_of(action)] = row
             parts.append(rows.ravel())
         parts.append(mask.astype(float))
+        if self.allocation:
+            parts.append(allocation_features(state.progress))
         vector = np.clip(np.concatenate(parts), 0.0, 1.0).astype(np.float32)
         return Observation(vector, mask, tuple(actions))
 
     def record(self) -> dict:
         """The layout as a TOML-ready table (a policy file stores it)."""
-        return {"concepts": list(self.concepts), "max_objects": int(self.max_objects), "whatif": bool(self.whatif),
-                "features": list(FEATURE_NAMES)}
+        record = {"concepts": list(self.concepts), "max_objects": int(self.max_objects), "whatif": bool(self.whatif),
+                  "features": list(FEATURE_NAMES)}
+        if self.allocation:  # files of policies trained on one allocation stay as they were
+            record |= {"allocation": True, "allocation_features": list(ALLOCATION_NAMES)}
+        return record

@@ -30,7 +30,7 @@ from learning.decision.weights_file import check_bare_key, toml_value
 from learning.errors import DataFileError
 from learning.limits import limit as limit_of
 from learning.limits import maximum
-from learning.rl.observation import ObservationLayout
+from learning.rl.observation import ALLOCATION_NAMES, ObservationLayout
 
 FORMAT = "teachbot-questioner"
 VERSION = 1
@@ -148,9 +148,15 @@ def load_policy(path: str | Path) -> QuestionerPolicy:
         raise DataFileError(f"{here}: format must be '{FORMAT}' version {VERSION}, got "
                             f"'{table['format']}' version {table['version']}")
     observed, there = section(data, "observation", where), f"{where} [observation]"
-    check_keys(observed, there, required=("concepts", "max_objects", "whatif", "features"))
+    check_keys(observed, there, required=("concepts", "max_objects", "whatif", "features"),
+               optional=("allocation", "allocation_features"))
     if tuple(texts(observed, "features", there)) != FEATURE_NAMES:
         raise DataFileError(f"{there}: features must be {list(FEATURE_NAMES)} (the decision features, in order)")
+    allocation = flag(observed, "allocation", there) if "allocation" in observed else False
+    if allocation and tuple(texts(observed, "allocation_features", there) if "allocation_features" in observed
+                            else ()) != ALLOCATION_NAMES:
+        raise DataFileError(f"{there}: allocation_features must be {list(ALLOCATION_NAMES)} (the allocation's "
+                            "features, in order) when allocation is true")
     npz = weights_beside(path, text(table, "weights", here), here)
     raw = npz.read_bytes()
     if hashlib.sha256(raw).hexdigest() != text(table, "sha256", here):
@@ -168,7 +174,7 @@ def load_policy(path: str | Path) -> QuestionerPolicy:
     try:
         layout = ObservationLayout(tuple(concepts),
                                    integer(observed, "max_objects", there, low=1, high=maximum("scene_objects")),
-                                   flag(observed, "whatif", there))
+                                   flag(observed, "whatif", there), allocation)
         policy = QuestionerPolicy(layout, weights, biases, text(table, "activation", here, choices=ACTIVATIONS),
                                   dict(section(data, "provenance", where, {})))
     except DataFileError as error:

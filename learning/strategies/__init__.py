@@ -14,11 +14,14 @@ all-cd     All/CD: feature query, a few demos keeping classes uniform, then A
 dt         DT with the weights in learning/decision/presets/dt.toml (or ``weights=``)
 dt-iros    DT on ACD and CDU (thesis ch. 6)
 dt-task    DT on ACD, CDU, IV and PM (thesis ch. 7)
+dt-iros-v1 dt-iros's hand-set weights from before the calibration rule (docs/calibration.md)
+dt-task-v1 dt-task's hand-set weights from before the calibration rule (docs/calibration.md)
 dt-task-env DT on the seven decision features and the expert-habit ones (thesis ch. 7; IRL weights, issue 27)
 dt-task-env-thesis DT-task-env on the thesis's seven features only (the earlier trajectory-level IRL fit)
 dt-task-env-no-env ablation: dt-task-env's weights without the environment features (docs/irl.md)
 dt-task-habits ablation: DT-task's learning weights with dt-task-env's habit-feature weights (docs/irl.md)
 scripted-expert the scripted expert of thesis §7.4.1 (rules in data/scripted-expert.toml)
+dt-voi     the question whose expected gain in objects right beats its price, from the allocation (beyond the thesis)
 rl:FILE    a trained questioner policy (teachbot train-questioner; beyond the thesis)
 pkg.mod:Cls your own strategy class, imported from an importable module (runs your code; plugins.py)
 ========== ==================================================================
@@ -46,6 +49,7 @@ from learning.strategies.random_choice import RandomStrategy
 from learning.strategies.rl_questioner import PREFIX as RL_PREFIX
 from learning.strategies.rl_questioner import RLQuestionerStrategy
 from learning.strategies.scripted_expert import ScriptedExpertStrategy
+from learning.strategies.voi import ValueOfInformationStrategy
 
 STRATEGIES: dict[str, Callable[..., Strategy]] = {
     "passive": PassiveStrategy,
@@ -57,6 +61,8 @@ STRATEGIES: dict[str, Callable[..., Strategy]] = {
     "dt": partial(DecisionTheoreticStrategy, "dt"),
     "dt-iros": partial(DecisionTheoreticStrategy, "dt-iros"),
     "dt-task": partial(DecisionTheoreticStrategy, "dt-task"),
+    "dt-iros-v1": partial(DecisionTheoreticStrategy, "dt-iros-v1"),
+    "dt-task-v1": partial(DecisionTheoreticStrategy, "dt-task-v1"),
     "dt-task-env": partial(DecisionTheoreticStrategy, "dt-task-env"),
     "dt-task-env-thesis": partial(DecisionTheoreticStrategy, "dt-task-env-thesis"),
     "dt-task-env-no-env": partial(DecisionTheoreticStrategy, "dt-task-env-no-env"),
@@ -64,6 +70,7 @@ STRATEGIES: dict[str, Callable[..., Strategy]] = {
     "scripted-expert": ScriptedExpertStrategy,
     "passive-fs": PassiveFeatureSelectingStrategy,
     "active-fs": ActiveFeatureSelectingStrategy,
+    "dt-voi": ValueOfInformationStrategy,
 }
 STRATEGY_NAMES = tuple(STRATEGIES)
 # the strategy of the library's TeachingLoop, of EpisodeSettings, and of teach and demo, written once

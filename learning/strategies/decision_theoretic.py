@@ -8,7 +8,8 @@ nothing and lengthens the quiet run). The learner takes the best query a* only i
 EU(no query), else it asks nothing this turn; ties between queries go to the first in
 candidate order (demos, labels, FSQ). Expected utilities closer than ``EU_RESOLUTION`` are
 equal (``learning.decision.resolution``), so that rounding decides neither a tie nor staying
-quiet. Every explanation says what no query was scored at.
+quiet. Every explanation says in words which weighted feature decided (``learning.decision.reasons``), and
+the decision carries each feature's term of EU(a*) - EU(no query) (``Decision.terms``).
 
 With embodied costs (thesis §8.2.2; the state's ``seconds_clock``) remaining time reads seconds at each
 candidate's own next state, (T_s - elapsed - E[seconds(a)]) / T_s (eq. 7.1), and of the queries that beat
@@ -30,6 +31,7 @@ from learning.actions import Action, Decision
 from learning.concepts import normalise_rows
 from learning.decision.candidates import CandidateFeatures
 from learning.decision.embodied import choose_per_second
+from learning.decision.reasons import utility_terms, why_ask, why_quiet
 from learning.decision.resolution import EU_RESOLUTION, first_of_best
 from learning.decision.weights import resolve_weights, weighs_habits
 from learning.state import LearningState
@@ -56,24 +58,16 @@ class DecisionTheoreticStrategy(CandidateStrategy):
         utilities = candidates.utilities(self.weights)
         best, stay = choose_index(utilities, candidates.seconds), candidates.no_query_index
         if best == stay:
-            queries = utilities[:-1]
-            top = best_query(queries)
-            return Decision(candidates.actions[stay], _quiet_reason(state, candidates.actions[top], queries[top],
-                                                                      utilities[stay]))
+            top = best_query(utilities[:-1])
+            terms = utility_terms(candidates.expected, self.weights, top, stay, candidates.feature_names)
+            return Decision(candidates.actions[stay], _quiet_reason(state, terms), terms)
         action = candidates.actions[best]
-        reason = _query_reason(state, action, utilities[best], utilities[stay])
+        terms = utility_terms(candidates.expected, self.weights, best, stay, candidates.feature_names)
+        reason = _query_reason(state, action, terms)
         if candidates.seconds is not None:  # embodied costs: the gain per expected second chose it
-            took = candidates.seconds[best]
-            reason += (f" It should take about {took:.1f} s, {(utilities[best] - utilities[stay]) / took:.4f} "
-                       "utility a second, the most of the questions worth asking.")
-        return Decision(action, reason)
-
-
-def quiet_basis(state: LearningState) -> str:
-    """What EU(no query) is scored at (eq. 7.1), in words."""
-    run = state.quiet_run() + 1
-    return (f"both scored at the next turn; staying quiet learns nothing and makes {run} quiet "
-            f"turn{'s' if run != 1 else ''} in a row")
+            reason += (f" Of the questions worth asking, it should gain the most per second it takes "
+                       f"(about {max(1, round(float(candidates.seconds[best])))} s).")
+        return Decision(action, reason, terms)
 
 
 def choose_index(utilities: np.ndarray, seconds: np.ndarray | None = None) -> int:
@@ -96,30 +90,22 @@ def best_query(queries: np.ndarray) -> int:
     return first_of_best(queries, EU_RESOLUTION * max(1.0, abs(float(queries.max()))))
 
 
-def _describe(state: LearningState, action: Action) -> str:
-    if action.kind == "label":
-        return f"asking what object {action.object_index + 1} is"
-    if action.kind == "demo":
-        return f"asking for a demonstration of {action.concept}"
-    return "asking which features matter"
-
-
-def _query_reason(state: LearningState, action: Action, utility: float, quiet: float) -> str:
-    numbers = f"expected utility {utility:.3f} against {quiet:.3f} if I stay quiet, {quiet_basis(state)}"
+def _query_reason(state: LearningState, action: Action, terms) -> str:
+    """Why this question, in words: what it is about and the feature that decided it (no utility numbers)."""
     if action.kind == "label":
         P = normalise_rows(state.probabilities())
         first, second = (state.concepts[i] for i in np.argsort(P[action.object_index])[::-1][:2])
-        return f"I can't tell {first} from {second} for object {action.object_index + 1}, so I ask ({numbers})."
+        return (f"I can't tell {first} from {second} for object {action.object_index + 1}, so I ask: "
+                f"{why_ask(terms, first, 'label')}.")
     if action.kind == "demo":
         count = state.counts_per_concept()[action.concept]
-        return (f"A demonstration of {action.concept} should help most: I have {count} "
-                f"example{'s' if count != 1 else ''} of it ({numbers}).")
-    return f"Knowing which features matter should help most ({numbers})."
+        return (f"I ask for a demonstration of {action.concept}, of which I have {count} "
+                f"example{'s' if count != 1 else ''}: {why_ask(terms, action.concept, 'demonstration')}.")
+    return f"I ask which features matter: {why_ask(terms, 'the concepts', 'question')}."
 
 
-def _quiet_reason(state: LearningState, best: Action, utility: float, quiet: float) -> str:
-    numbers = (f"{_describe(state, best)} is worth {utility:.3f} against {quiet:.3f} for staying quiet, "
-               f"{quiet_basis(state)}")
+def _quiet_reason(state: LearningState, terms) -> str:
+    """Why no question, in words: what outweighed what the best question promised (no utility numbers)."""
     if state.last_query_scene_id is not None and state.last_query_scene_id == state.scene_id:
-        return f"Nothing to ask: the scene hasn't changed since my last question ({numbers})."
-    return f"Nothing to ask: no question is worth its cost now ({numbers})."
+        return f"Nothing to ask: the scene hasn't changed since my last question, and {why_quiet(terms)}."
+    return f"Nothing to ask: {why_quiet(terms)}."

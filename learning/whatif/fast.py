@@ -72,13 +72,15 @@ class FastEngine(WhatIfEngine):
         return Outcomes(demo, label, feature, label_objects, shared=True)
 
 
-def pair_table(state) -> np.ndarray:
+def pair_table(state, extra: np.ndarray | None = None) -> np.ndarray:
     """[x, y, i, c]: p(c | scene object i) after adding <scene object x, concept y> to the training set.
 
     Classifiers on the same features share their kernels (they share the training rows) and their one-site
-    updates run as one batch (``one_site_probabilities`` on ``stack_posteriors``).
+    updates run as one batch (``one_site_probabilities`` on ``stack_posteriors``). ``extra`` (raw rows, as the
+    scene's) joins the scene on both axes: x and i then run over the scene objects, then the extra rows
+    (``learning.decision.voi`` scores a pool of objects seen before this way).
     """
-    scene = state.scaled_scene()
+    scene = state.scaled_scene() if extra is None else state.scaler.transform(np.vstack([state.scene_X, extra]))
     n_objects, n_concepts = len(scene), len(state.concepts)
     table = np.empty((n_objects, n_concepts, n_objects, n_concepts))
     groups: dict[tuple, list[int]] = {}
@@ -97,18 +99,22 @@ def pair_table(state) -> np.ndarray:
     return table
 
 
-def feature_outcomes(state) -> np.ndarray:
+def feature_outcomes(state, extra: np.ndarray | None = None) -> np.ndarray:
     """[y, i, c]: p(c | scene object i) if the teacher answered the FSQ with F_{y,c} (thesis §6.4.2).
 
     Each distinct subset is refit once per classifier: with a low-rank kernel when the subset has one
     (``_fit_low_rank``), else exactly, every remaining (subset, classifier) pair one row of a single
-    batched ``fit_modes`` call warm-started from the classifier's current latent mode.
+    batched ``fit_modes`` call warm-started from the classifier's current latent mode. ``extra`` (raw rows)
+    joins the scene as in ``pair_table``: i runs over the scene objects, then the extra rows.
     """
     subsets = cached(state, "fast.subsets", state.training_version, lambda: feature_query_subsets(state))
     X, labels = state.scaled_training()
-    scene = state.scaled_scene()
+    if extra is None:
+        scene, current = state.scaled_scene(), state.probabilities()
+    else:
+        judged = np.vstack([state.scene_X, extra])
+        scene, current = state.scaler.transform(judged), state.probabilities(judged)
     concepts = state.concepts
-    current = state.probabilities()
     outcome = np.empty((len(concepts), len(scene), len(concepts)))
     if len(X) == 0:  # no data: every subset gives the prior
         outcome[:] = current[None]

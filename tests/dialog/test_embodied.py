@@ -89,7 +89,7 @@ def test_an_embodied_episode_ends_when_its_seconds_are_used_up(tmp_path):
             assert record["seconds"] > costs.speaking[kind]
         if kind == "label":
             assert record["gesture"]["model_seconds"] > 0
-    assert any("utility a second" in r["explanation"] for r in records)
+    assert any("the most per second it takes" in r["explanation"] for r in records)
 
 
 def test_the_turns_cap_still_ends_an_embodied_episode(tmp_path):
@@ -112,7 +112,7 @@ def test_dt_in_turns_ignores_the_seconds(tmp_path):
     with pytest.raises(SettingsError, match="only a DT strategy"):
         make_strategy("active+turns")
     _, path, _ = embodied_run(tmp_path, strategy="dt-task+turns")
-    assert not any("utility a second" in r["explanation"] for r in read_transcript(path))
+    assert not any("the most per second it takes" in r["explanation"] for r in read_transcript(path))
 
 
 @pytest.mark.parametrize("argv, expected", [

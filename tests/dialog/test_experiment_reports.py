@@ -10,12 +10,13 @@ import pytest
 
 from dialog.cli import main
 from dialog.experiments import kinds, pools, registry
-from dialog.experiments.analysis import evaluate_findings, skipped_by_overrides, summarise
+from dialog.experiments.analysis import BOOTSTRAP_SEED, compare, evaluate_findings, skipped_by_overrides, summarise
 from dialog.experiments.baseline import make_baseline
 from dialog.experiments.figures import learning_curve_figure, strategy_styles, timing_figure
 from dialog.experiments.report import markdown_report
 from dialog.experiments.runner import RenderBar
 from dialog.experiments.suite import SuiteError, load_suite
+from learning.significance import cluster_bootstrap_ci
 
 SUITE = """
 name = "reports"
@@ -68,8 +69,8 @@ def episode(strategy, condition, turns, dataset, level, questions=None):
     """A fake episode result: accuracy rising to ``level``; ``questions`` asked (default: one per turn)."""
     asked = questions if questions is not None else list(range(1, turns + 1))
     accuracy = list(np.linspace(0.2, level, turns) + 0.01 * dataset)
-    return {"spec": {"condition": {"name": condition, "turns": turns}, "strategy": strategy, "dataset": dataset,
-                     "seed": 0},
+    return {"spec": {"condition": {"name": condition, "turns": turns, "budget": turns}, "strategy": strategy,
+                     "dataset": dataset, "seed": 0, "costs": ()},
             "series": {"turn": list(range(1, turns + 1)), "accuracy": accuracy, "questions": asked,
                        "label": asked, "demo": [0] * turns, "feature": [0] * turns, "spent": asked},
             "accuracy": accuracy[-1], "seconds": 0.01}
@@ -163,7 +164,7 @@ def test_checkpoints_beyond_a_conditions_turns_are_left_out_and_headings_name_th
     assert "two-sided tests between every pair of strategies after 4 turns." in short
     assert "| strategy | after 2 turns | after 4 turns | after 8 turns |" in long
     assert "two-sided tests between every pair of strategies after 8 turns." in long
-    assert "(planned)" in report and "Holm" in report and "(4 clusters)" in report
+    assert "(planned)" in report and "Holm" in report and "none (1 cluster)" in report  # all of data seed 0
     assert "late-in-short: passive beats active after 8 turns: skipped, it compares after 8 turns" in report
     assert "| late-in-long: passive beats active after 8 turns | long | 8 turns | passive > active |" in report
     bands = make_baseline(suite, summaries)["bands"]
@@ -249,3 +250,29 @@ def test_report_headers_say_seeds_and_teachers_in_words():
     assert numbers_in_words((3,)) == "3" and numbers_in_words((0, 1)) == "0, 1"
     assert teacher_in_words({}) == "scripted" and teacher_in_words({"kind": "oracle"}) == "oracle"
     assert teacher_in_words({"kind": "scripted", "mislabel_rate": 0.1}) == "scripted (mislabel rate 0.1)"
+
+
+def test_the_interval_resamples_data_seeds_and_names_how_many(tmp_path):
+    """The episodes of one data seed share its test pool: a data seed is one cluster, whatever its data sets and
+    seeds; one data seed gives no interval (the other test of reports), three give three clusters."""
+    suite = load_suite(suite_file(tmp_path))
+    results = fake_results(suite)  # every data set x seeds 0-1, all of data seed 0
+    episodes = suite.datasets * 2
+    for result in results:
+        result["spec"]["data_seed"] = (result["spec"]["dataset"] + result["spec"]["seed"]) % 3  # data seeds 0-2
+    summaries = summarise(results, suite)
+    long = [s for s in summaries if s.condition == "long"]
+    comparison = compare(long[0], long[1], -1)
+    assert comparison.n == episodes > 3 and comparison.clusters == 3 and comparison.ci is not None
+    for result in results:
+        result["spec"]["data_seed"] = 7 if result["spec"]["seed"] == 0 else 9
+    summaries = summarise(results, suite)
+    long = [s for s in summaries if s.condition == "long"]
+    comparison = compare(long[0], long[1], -1)
+    assert comparison.n == episodes and comparison.clusters == 2
+    differences = long[0].values[:, -1] - long[1].values[:, -1]
+    by_seed = [7 if key[2] == 0 else 9 for key in long[0].keys]
+    assert comparison.ci == cluster_bootstrap_ci(differences, by_seed, np.random.default_rng(BOOTSTRAP_SEED))
+    report = markdown_report(suite, results, summaries, evaluate_findings(summaries, suite), 1.0, tmp_path,
+                             []).read_text()
+    assert "(2 clusters)" in report and "none (1 cluster)" not in report

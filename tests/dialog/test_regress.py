@@ -254,6 +254,9 @@ def test_a_suite_on_several_data_seeds_reports_each_and_pooled(tmp_path, capsys)
     text = (out / "replication.md").read_text()
     assert "| finding | data seed 0 | data seed 1 | pooled | pooled pairs |" in text
     assert "teachbot regress --suite" in text and "--data-seeds 0 1" in text
+    assert "(2 clusters)" in text  # the pooled interval resamples the two data seeds
+    assert "none (1 cluster)" in (out / "data-seed-0" / "report.md").read_text()  # one data seed: no interval
+    assert "Quiet turns with budget left" in text.split("pooled over the data seeds")[1]
     assert main(["regress", "--suite", str(suite), "--data-seeds", "0", "0", "--results", str(out)]) == 2
     assert "each data seed once" in capsys.readouterr().err
     assert main(["regress", "--suite", str(suite), "--data-seeds", "0", "--check", "--results", str(out)]) == 2

@@ -1,5 +1,6 @@
 """How a page session ends: quit, Ctrl-C and a full disk each keep ``--web`` in the "continue with" command, and
-the page says what happened (issue 42, case 4)."""
+the page says what happened (issue 42, case 4). The command is the researcher's: it is printed at the terminal,
+and the page says in plain words that the session is saved (issue 41, item 4)."""
 
 from __future__ import annotations
 
@@ -108,8 +109,9 @@ def test_quit_in_the_page_keeps_web_in_the_continue_command_and_the_page_says_so
         command.stop()
     again = "Continue it with: teachbot teach --resume runs/t.jsonl --web --no-3d"
     assert any(again in line for line in command.out), "".join(command.out)
-    assert page.ended is not None and "Session saved after 1 of 3 turns" in page.ended and again in page.ended
-    assert "Accuracy on" in page.ended
+    assert page.ended is not None and "The session is saved after 1 of 3 turns" in page.ended
+    assert "The robot now names" in page.ended and "teachbot" not in page.ended and "--resume" not in page.ended
+    assert "pack-lunchbox" not in page.ended and ".jsonl" not in page.ended
 
 
 def test_ctrl_c_at_the_terminal_keeps_web_and_the_page_says_it_was_interrupted(tmp_path):
@@ -128,7 +130,8 @@ def test_ctrl_c_at_the_terminal_keeps_web_and_the_page_says_it_was_interrupted(t
         command.stop()
     again = "continue it with: teachbot teach --resume runs/t.jsonl --web --no-3d"
     assert any(again in line for line in command.out), "".join(command.out)
-    assert page.ended is not None and page.ended.startswith("Interrupted.") and again in page.ended
+    assert page.ended is not None and page.ended.startswith("The session was interrupted.")
+    assert "teachbot" not in page.ended and ".jsonl" not in page.ended
     assert "Traceback" not in "".join(command.err)
 
 
@@ -162,5 +165,6 @@ def test_a_full_disk_keeps_web_and_the_page_says_what_stopped_the_session(tmp_pa
         subprocess.run(["umount", "-l", str(disk)], check=False)
     err = "".join(command.err)
     assert "Traceback" not in err and "--web --no-3d" in err, err[-2000:]
-    assert page.ended is not None and "ENOSPC" in page.ended and "--resume disk/t.jsonl" in page.ended
-    assert page.ended.endswith("--web --no-3d")
+    assert "ENOSPC" in err and "--resume disk/t.jsonl" in err
+    assert page.ended is not None and page.ended.startswith("The session stopped: the computer could not save")
+    assert "teachbot" not in page.ended and ".jsonl" not in page.ended

@@ -1,5 +1,7 @@
 """``teachbot study run --web``: a participant does the example study in headless Chromium with clicks only, and the
-files pass ``study status`` and ``study report`` as a terminal session's do."""
+files pass ``study status`` and ``study report`` as a terminal session's do. Every screen (the instructions, each
+question kind, the questionnaire, the pause, the end) is in a participant's words (issue 41, item 4): the header
+says which screen it is, its text names its button, and nothing names a condition, strategy, task or file."""
 
 from __future__ import annotations
 
@@ -14,6 +16,7 @@ from bullet_world.viewer.snapshot import find_chromium
 from dialog.study.files import session_files
 from dialog.study.studyfile import load_study
 from dialog.transcripts.jsonl import read_session
+from tests.e2e.plain_words import check_screen
 from tests.e2e.web_helpers import TEACHBOT, WebCommand, chromium, open_page
 
 pytestmark = [
@@ -28,15 +31,24 @@ READY = """() => ended || (question && waiting && document.getElementById('scree
     || (!document.getElementById('screen').hidden && !document.querySelector('#screen form > button').disabled)"""
 
 
-def click_through(page, titles: list[str]) -> int:
-    """Answer every screen and question by clicking until the run ends; returns the questions answered."""
-    answered = 0
+def click_through(page, titles: list[str], seen: dict | None = None) -> int:
+    """Answer every screen and question by clicking until the run ends; returns the questions answered. Each
+    screen's visible text is checked for the researcher's words (``seen``: each kind of screen's last text)."""
+    answered, seen = 0, {} if seen is None else seen
     while True:
         page.wait_for_function(READY, timeout=120_000)
         if page.evaluate("() => ended"):
+            check_screen(page, "end", seen)
             return answered
         if not page.locator("#screen").is_hidden():
             titles.append(page.inner_text("#screen h2"))
+            kind = {"A short break": "pause", "A few questions about this session": "questionnaire"}.get(
+                titles[-1], "instructions")
+            check_screen(page, kind, seen)
+            seen[f"{kind}: {titles[-1]}"] = seen[kind]
+            assert page.inner_text("#status") == titles[-1]  # the header says what the screen is
+            button = page.inner_text("#screen form > button")
+            assert "Press Enter" not in seen[kind] and ("Press" not in seen[kind] or f'"{button}"' in seen[kind])
             for group in page.locator("#screen fieldset").all():
                 radios = group.locator("input[type=radio]")
                 if radios.count():
@@ -44,6 +56,7 @@ def click_through(page, titles: list[str]) -> int:
             page.locator("#screen form > button").click()
             continue
         question = page.evaluate("() => question")
+        check_screen(page, f"{question['expects']} question", seen)
         if question["expects"] == "label":
             page.locator("#answers button").nth(answered % len(question["concepts"])).click()
         elif question["expects"] == "demo":
@@ -60,10 +73,11 @@ def test_a_participant_does_the_example_study_in_the_browser_with_clicks_only(tm
     command = WebCommand("study", "run", EXAMPLE, "--participant", "P01", "--folder", folder, "--web", "--no-viewer",
                          cwd=tmp_path)
     titles: list[str] = []
+    seen: dict[str, str] = {}
     try:
         with chromium() as browser:
             page = open_page(browser, command.url)
-            answered = click_through(page, titles)
+            answered = click_through(page, titles, seen)
         assert command.finish(120) == 0, "".join(command.err)
     finally:
         command.stop()
@@ -73,6 +87,9 @@ def test_a_participant_does_the_example_study_in_the_browser_with_clicks_only(tm
     assert not any(condition.name in title for condition in study.conditions for title in titles)
     assert "budget" not in shown.lower()
     assert answered >= 3
+    assert {"instructions", "label question", "questionnaire", "pause", "end"} <= set(seen), sorted(seen)
+    assert 'Press "Go on"' in seen["pause"]
+    assert any('press "Why?"' in text for key, text in seen.items() if key.startswith("instructions: "))
 
     from dialog.study.design import assigned_orders
 

@@ -6,11 +6,17 @@ where the camera projects it, a reload and a second tab mid-session, forged and
 wrong-token messages, a quit and a resume. The transcript must equal the same
 answers typed at the terminal, field for field, but for the clock fields and
 the page's channel fields.
+
+On every screen of that session (each question kind, Why, Help, Undo, the
+reload, Quit, the resumed page, the end) the page speaks a participant's words
+(issue 41, item 4; ``tests/e2e/plain_words.py``): no strategy, task id, file,
+command or utility number; what the researcher needs is at the terminal.
 """
 
 from __future__ import annotations
 
 import json
+import re
 import subprocess
 import urllib.error
 import urllib.request
@@ -21,6 +27,7 @@ from bullet_world.viewer.snapshot import find_chromium
 from dialog.environment import SimulatedKitchen
 from dialog.manager import episode_generators
 from dialog.transcripts.jsonl import read_session
+from tests.e2e.plain_words import check_screen, decimals_in, researcher_words_in
 from tests.e2e.web_helpers import TEACHBOT, WebCommand, chromium, comparable, open_page, send_raw, wait_for_question
 
 pytestmark = [
@@ -87,6 +94,10 @@ def answer(page, question: dict, truth: Truth, keyboard: bool = False) -> str:
         page.wait_for_function("() => document.getElementById('picture').complete")
         click_picture(page, example[1])
         return "click"
+    labels = page.locator("#features label").all_inner_texts()
+    assert labels and not [label for label in labels if re.match(r"\s*\d+(\.\d+)+", label)], labels
+    assert any("its colour" in label for label in labels), labels
+    assert "Tick" in question["text"] and "numbers" not in question["text"]
     for number in ("1.1", "1.2", "1.5"):
         page.locator(f"#features input[data-number='{number}']").check()
     page.get_by_role("button", name="use these").click()
@@ -108,12 +119,24 @@ def http_status(url: str, headers: dict | None = None) -> int:
         return error.code
 
 
+def budget_shown(page) -> float:
+    return float(re.search(r"budget left ([0-9.]+)", page.inner_text("#meta")).group(1))
+
+
+def conversation(page) -> str:
+    return page.inner_text("#conversation")
+
+
 def test_a_whole_session_in_the_browser_equals_the_same_answers_typed(tmp_path):
     web, terminal = tmp_path / "web", tmp_path / "terminal"
     web.mkdir()
     terminal.mkdir()
     truth = Truth(scenes=2)
     channels = []
+    seen: dict[str, str] = {}  # each screen visited: its visible text (checked for the researcher's words)
+    asked: list[str] = []      # the questions of the first run, as the page showed them
+    why = ""
+    budgets = {}
     try:
         with chromium() as browser:
             first = WebCommand("teach", "--web", *OPTIONS, "--transcript", "runs/t.jsonl", cwd=web)
@@ -140,27 +163,48 @@ def test_a_whole_session_in_the_browser_equals_the_same_answers_typed(tmp_path):
                 assert page.evaluate("""(url) => new Promise(done => { const s = new WebSocket(url);
                     s.onopen = () => done('open'); s.onerror = () => done('refused'); })""",
                                      base.replace("http", "ws") + "ws?token=wrong") == "refused"
+                assert "Help the robot learn what the words of this kitchen task mean" in page.inner_text("body")
                 done_turns = 0
                 while done_turns < 5:
+                    asked.append(question["text"])
+                    check_screen(page, f"{question['expects']} question", seen, (why,))
                     if question["turn"] == 2:
                         page.get_by_role("button", name="Why?").click()  # a reply; the question stays open
-                        page.wait_for_function("() => waiting")
+                        page.wait_for_function("() => waiting && document.getElementById('conversation')"
+                                               ".textContent.includes('Why I ask')")
+                        why = page.locator("#conversation li.robot").last.inner_text().strip()
+                        seen["why"] = page.inner_text("body")  # checked with the Why sentence at the end
                     if question["turn"] == 3:
                         page.reload()  # a reload rejoins the session: the same question, still waiting
                         again = wait_for_question(page)
                         assert again["id"] == question["id"] and again["text"] == question["text"]
+                        assert asked[0] in conversation(page) and "Why I ask" in conversation(page)
+                        check_screen(page, "reloaded page", seen, (why,))
                         second = open_page(browser, first.url)  # so does a second tab
                         assert wait_for_question(second)["text"] == question["text"]
                         second.close()
+                        budgets["before undo"] = budget_shown(page)
                         page.get_by_role("button", name="Undo").click()  # takes back turn 2's answer
                         page.wait_for_function("() => waiting && document.getElementById('conversation')"
                                                ".textContent.includes('Taken back')")
+                        budgets["after undo"] = budget_shown(page)  # at once, before the next answer
+                        check_screen(page, "undo", seen, (why,))
+                    if question["turn"] == 4:
+                        page.get_by_role("button", name="Help").click()
+                        page.wait_for_function("() => waiting && document.getElementById('conversation')"
+                                               ".textContent.includes('\"Why?\" asks my reason')")
+                        check_screen(page, "help", seen, (why,))
                     channels.append(answer(page, question, truth, keyboard=question["turn"] == 1))
                     done_turns += 1
                     question = wait_for_question(page, after=question["id"])
                 page.get_by_role("button", name="Quit").click()
+                page.wait_for_function("() => ended")
+                assert "saved after 5 of 8 turns" in check_screen(page, "quit", seen, (why,))
                 assert first.finish() == 0
                 assert any("Session saved after 5 of 8 turns" in line for line in first.out)
+                terminal_text = "".join(first.out)  # the researcher's: the strategy, the file, the command
+                assert "strategy dt-task" in terminal_text and "Transcript: runs/t.jsonl" in terminal_text
+                assert "teachbot teach --resume runs/t.jsonl --web" in terminal_text
             finally:
                 first.stop()
 
@@ -169,9 +213,14 @@ def test_a_whole_session_in_the_browser_equals_the_same_answers_typed(tmp_path):
                 page = open_page(browser, second_run.url)
                 question = wait_for_question(page)
                 assert question["turn"] == 6
+                shown = conversation(page)  # the conversation so far, from the transcript
+                assert all(text in shown for text in asked), (asked, shown)
+                check_screen(page, "resumed page", seen, (why,))
                 while not question.get("ended"):
+                    check_screen(page, f"{question['expects']} question", seen, (why,))
                     channels.append(answer(page, question, truth))
                     question = wait_for_question(page, after=question["id"])
+                assert "The robot now names" in check_screen(page, "end", seen, (why,))
                 assert second_run.finish() == 0
             finally:
                 second_run.stop()
@@ -181,6 +230,9 @@ def test_a_whole_session_in_the_browser_equals_the_same_answers_typed(tmp_path):
     header, records = read_session(web / "runs/t.jsonl")
     assert [r["turn"] for r in records] == list(range(1, TURNS + 1))
     assert records[2]["undid"] == [2]
+    assert budgets["after undo"] == budgets["before undo"] + records[1]["cost"] > budgets["before undo"]
+    assert {"label question", "demo question", "feature question", "why", "undo", "help", "reloaded page", "quit",
+            "resumed page", "end"} <= set(seen), sorted(seen)
     assert "click" in channels and "button" in channels
     for record in records:
         assert len(record["answer"]["channels"]) == len(record["answer"]["lines"])
@@ -193,3 +245,8 @@ def test_a_whole_session_in_the_browser_equals_the_same_answers_typed(tmp_path):
     _, at_terminal = read_session(terminal / "runs/t.jsonl")
     assert "channels" not in json.dumps(at_terminal)
     assert [comparable(r) for r in records] == [comparable(r) for r in at_terminal]
+    # "Why?" answers in a sentence without utility numbers (the Why line is left out of the checks of each screen
+    # above and checked here, once). Last, so that every check above is made first: the strategies' reasons in
+    # plain words come with issue 39's rewrite (branch w39stall); until it is merged this assertion fails.
+    assert why.startswith("Robot: Why I ask: ") and why.rstrip().endswith((".", ")"))
+    assert not researcher_words_in(seen["why"]) and not decimals_in(why), why

@@ -86,3 +86,11 @@ def test_holm_adjusts_step_down_and_keeps_the_order():
     assert [c.p_holm for c in adjusted] == pytest.approx([0.03, 0.06, 0.06])
     assert adjusted[0].significant and not adjusted[1].significant and not adjusted[2].significant
     assert holm([]) == []
+
+
+def test_one_cluster_gives_no_interval_and_one_difference_a_cluster_is_the_plain_bootstrap():
+    d = np.array([0.1, 0.3, 0.2, 0.4])
+    assert cluster_bootstrap_ci(d, [7, 7, 7, 7], np.random.default_rng(1)) is None
+    assert wilcoxon_paired("a", d, "b", np.zeros(4), clusters=[7] * 4).ci is None
+    plain = wilcoxon_paired("a", d, "b", np.zeros(4), rng=np.random.default_rng(1))
+    assert plain.clusters == 4 and plain.ci == cluster_bootstrap_ci(d, range(4), np.random.default_rng(1))

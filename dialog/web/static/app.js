@@ -51,6 +51,8 @@ function handle(message) {
     showQuestion(message.question);
   } else if (message.type === "waiting") {
     if (question && message.question === question.id) { setWaiting(true); }
+  } else if (message.type === "budget") {  // an undo gave budget back
+    if (question && message.question === question.id) { question.budget_left = message.budget_left; showMeta(question, true); }
   } else if (message.type === "refused") {
     $("refused").textContent = `Not taken: ${message.reason}`;
     setWaiting(true);
@@ -96,10 +98,7 @@ function showQuestion(asked) {
   $("screen").hidden = true;
   $("ask").hidden = false;
   $("typed").hidden = $("commands").hidden = Boolean(asked.watch);  // a demo: watched, not answered
-  let meta = `Turn ${asked.turn}` + (asked.turns ? ` of ${asked.turns}` : "")
-    + (asked.budget_left === null ? "" : ` · budget left ${asked.budget_left}`);
-  if (asked.seconds_left !== null) { meta += ` · <span id="countdown">${Math.round(asked.seconds_left)}</span> s to answer`; }
-  $("meta").innerHTML = meta;
+  showMeta(asked);
   if (asked.seconds_left !== null) { countdown(asked.id, asked.seconds_left); }
   $("question-text").textContent = asked.text;
   const answers = $("answers");
@@ -139,6 +138,16 @@ function showQuestion(asked) {
   }
 }
 
+function showMeta(asked, again) {
+  // the turn, the budget left (unless hidden) and the seconds left; shown ``again`` (an undo), the countdown goes on
+  const counting = again ? $("countdown") : null;
+  let meta = `Turn ${asked.turn}` + (asked.turns ? ` of ${asked.turns}` : "")
+    + (asked.budget_left === null ? "" : ` · budget left ${asked.budget_left}`);
+  const seconds = counting ? counting.textContent : asked.seconds_left === null ? null : Math.round(asked.seconds_left);
+  if (seconds !== null) { meta += ` · <span id="countdown">${seconds}</span> s to answer`; }
+  $("meta").innerHTML = meta;
+}
+
 function clearQuestion() {
   question = null;
   $("question-text").textContent = "";
@@ -161,13 +170,7 @@ function featureTree(rows) {
         if (other.value.startsWith(row.number + ".")) { other.checked = check.checked; }
       });
     });
-    label.append(check, ` ${row.number} ${row.name}`);
-    if (row.description) {
-      const description = document.createElement("span");
-      description.className = "description";
-      description.textContent = ` (${row.description})`;
-      label.append(description);
-    }
+    label.append(check, ` ${row.label}`);  // words, not tree numbers: the number is the checkbox's value
     if (row.group) { label.style.fontWeight = "600"; }
     box.appendChild(label);
   });
@@ -187,6 +190,7 @@ function setWaiting(on) {
   waiting = Boolean(on) && !ended;
   document.querySelectorAll("#ask button, #ask input").forEach((element) => { element.disabled = !waiting; });
   if (waiting && question) { status(`Turn ${question.turn}: your answer, please`); }
+  else if (!ended && !$("screen").hidden) { status($("screen").dataset.title); }  // a study screen says what it is
   else if (!ended) { status("The robot is busy…"); }
 }
 
@@ -194,6 +198,8 @@ function showEnded(text) {
   ended = true;
   setWaiting(false);
   question = null;
+  $("screen").hidden = true;
+  $("ask").hidden = false;
   $("question-text").textContent = text || "The session is over. Thank you!";
   $("answers").replaceChildren();
   status("The session is over.");
@@ -215,7 +221,9 @@ function showScreen(screen) {
   const box = $("screen");
   box.replaceChildren();
   box.hidden = false;
+  box.dataset.title = screen.title;
   $("ask").hidden = true;
+  status(screen.title);
   const heading = document.createElement("h2");
   heading.textContent = screen.title;
   box.appendChild(heading);
