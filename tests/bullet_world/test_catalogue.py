@@ -87,9 +87,14 @@ def test_kitchen_locations_must_be_within_reach(tmp_path):
 
     text = (DATA_DIR / "kitchens" / "kitchen-1.toml").read_text()
     path = tmp_path / "kitchen.toml"
-    path.write_text(text.replace("stove = { centre = [0.51, -0.24, 0.0]", "stove = { centre = [1.5, 0.4, 0.0]"))
+    def edited(old: str, new: str) -> str:
+        assert old in text, old  # the edit really happens (the file's form changed once and this went silent)
+        return text.replace(old, new)
+
+    stove = "[locations.stove]\ncentre = "
+    path.write_text(edited(stove + "[0.51, -0.24, 0.0]", stove + "[1.5, 0.4, 0.0]"))
     with pytest.raises(DataFileError, match="locations must be within 0.8 m"):
         load_kitchen(path)
-    path.write_text(text.replace("pantry = {", "larder = {"))
+    path.write_text(edited("[locations.pantry]", "[locations.larder]"))
     with pytest.raises(DataFileError, match="missing pantry"):
         load_kitchen(path)
