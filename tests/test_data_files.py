@@ -23,26 +23,11 @@ from learning.decision.weights import PRESETS, preset_weights
 from learning.decision.weights_file import load_weights
 from learning.errors import DataFileError
 from learning.recipes.format import builtin_recipe_names, load_builtin_recipe, load_recipe
+from tests.datafile_edits import changed, refused
 
 KITCHEN = (DATA_DIR / "kitchens" / "kitchen-1.toml").read_text()
 TASK = (DATA_DIR / "tasks" / "pack-lunchbox.toml").read_text()
 SMOKE = (SUITE_DIR / "smoke.toml").read_text()
-
-
-def changed(text: str, old: str, new: str) -> str:
-    assert text.count(old) == 1, old
-    return text.replace(old, new)
-
-
-def refused(loader, path: Path, *fragments: str) -> str:
-    """Load ``path``, expect a one-line DataFileError naming the file and every fragment."""
-    with pytest.raises(DataFileError) as caught:
-        loader(path)
-    message = str(caught.value)
-    assert "\n" not in message and str(path) in message, message
-    for fragment in fragments:
-        assert fragment in message, message
-    return message
 
 
 def write(tmp_path: Path, text: str, name: str = "file.toml") -> Path:

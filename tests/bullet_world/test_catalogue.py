@@ -5,6 +5,7 @@ import pytest
 from bullet_world.catalogue import DataFileError, load_object_kinds, load_task
 from bullet_world.datafiles import available
 from bullet_world.kitchen import load_kitchen
+from tests.datafile_edits import changed
 
 GOOD_KIND = 'name = "x"\nconcept = "fruit"\nshape = "sphere"\nradius = [0.03, 0.04]\n' \
             'colours = [[1, 0, 0]]\ncolour_jitter = 0.0\nmass = [0.1, 0.2]\n'
@@ -87,14 +88,10 @@ def test_kitchen_locations_must_be_within_reach(tmp_path):
 
     text = (DATA_DIR / "kitchens" / "kitchen-1.toml").read_text()
     path = tmp_path / "kitchen.toml"
-    def edited(old: str, new: str) -> str:
-        assert old in text, old  # the edit really happens (the file's form changed once and this went silent)
-        return text.replace(old, new)
-
     stove = "[locations.stove]\ncentre = "
-    path.write_text(edited(stove + "[0.51, -0.24, 0.0]", stove + "[1.5, 0.4, 0.0]"))
+    path.write_text(changed(text, stove + "[0.51, -0.24, 0.0]", stove + "[1.5, 0.4, 0.0]"))  # asserts it edits
     with pytest.raises(DataFileError, match="locations must be within 0.8 m"):
         load_kitchen(path)
-    path.write_text(edited("[locations.pantry]", "[locations.larder]"))
+    path.write_text(changed(text, "[locations.pantry]", "[locations.larder]"))
     with pytest.raises(DataFileError, match="missing pantry"):
         load_kitchen(path)

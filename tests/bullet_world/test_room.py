@@ -4,8 +4,6 @@ measures of an object, and location names on the camera picture never cover an o
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pybullet as p
 import pytest
@@ -16,25 +14,9 @@ from bullet_world.datafiles import available
 from bullet_world.perception import measure_objects
 from bullet_world.room import FIXTURE_TOP_M
 from bullet_world.world import World
-from learning.errors import DataFileError
+from tests.datafile_edits import changed, refused
 
 KITCHEN = (DATA_DIR / "kitchens" / "kitchen-1.toml").read_text()
-
-
-def refused(text: str, tmp_path: Path, *fragments: str) -> None:
-    path = tmp_path / "kitchen.toml"
-    path.write_text(text)
-    with pytest.raises(DataFileError) as caught:
-        load_kitchen(path)
-    message = str(caught.value)
-    assert "\n" not in message and str(path) in message, message
-    for fragment in fragments:
-        assert fragment in message, message
-
-
-def changed(old: str, new: str) -> str:
-    assert KITCHEN.count(old) == 1, old
-    return KITCHEN.replace(old, new)
 
 
 @pytest.mark.parametrize("old, new, fragments", [
@@ -53,7 +35,9 @@ def changed(old: str, new: str) -> str:
      ("[locations.fridge]", "every location is built as a fixture")),
 ])
 def test_a_bad_room_names_the_file_and_field(tmp_path, old, new, fragments):
-    refused(changed(old, new), tmp_path, *fragments)
+    path = tmp_path / "kitchen.toml"
+    path.write_text(changed(KITCHEN, old, new))
+    refused(load_kitchen, path, *fragments)
 
 
 def test_every_kitchen_is_a_room_whose_fixture_tops_are_the_locations():
