@@ -28,12 +28,13 @@ from learning.errors import SettingsError, did_you_mean
 from learning.limits import check_limit
 
 WEIGHTS_DIRECTORY = Path(__file__).resolve().parent / "presets"
-# dt-task-env weighs the seven and the expert-habit features (issue 27); dt-task-env-thesis is the thesis's
-# seven-feature DT-task-env (the earlier trajectory fit); the last two are issue 27's pre-registered ablations
+# dt-task-env weighs the thesis's seven features with the thesis's signs (issue 39); dt-task-env-v1 the seven and
+# the expert-habit features (issue 27); dt-task-env-thesis the seven by the earlier trajectory fit; the last two
+# are issue 27's pre-registered ablations of dt-task-env-v1
 # (docs/irl.md); dt-iros-v1 and dt-task-v1 keep the hand-set weights of dt-iros and dt-task from before issue 39's
 # calibration rule (docs/calibration.md).
 PRESETS = ("dt", "dt-iros", "dt-task", "dt-iros-v1", "dt-task-v1",
-           "dt-task-env", "dt-task-env-thesis", "dt-task-env-no-env", "dt-task-habits")
+           "dt-task-env", "dt-task-env-v1", "dt-task-env-thesis", "dt-task-env-no-env", "dt-task-habits")
 
 
 def weight_vector(weights: Mapping[str, float] | Sequence[float] | np.ndarray, source: str = "weights") -> np.ndarray:

@@ -124,17 +124,25 @@ class ProtocolFit:
 
 
 def fit_protocol(episodes: Sequence[QuestioningEpisode], split_seeds: Sequence[int], fit_seeds: Sequence[int],
-                 policies: Sequence[str] = ("softmax", "gated"), iterations: int = 100) -> list[ProtocolFit]:
-    """Every (split seed, fit seed, policy) fit of the module docstring, in that order."""
+                 policies: Sequence[str] = ("softmax", "gated"), iterations: int = 100,
+                 signs: Sequence[tuple[str, int]] = ()) -> list[ProtocolFit]:
+    """Every (split seed, fit seed, policy) fit of the module docstring, in that order.
+
+    ``signs`` ((feature, +1 | -1) pairs) keep those weights >= 0 or <= 0 (issue 39); a random start takes
+    the sign's side (its absolute value, signed), so the starts stay as spread as without signs."""
     from learning.irl.maxent import IrlConfig, fit_maxent_irl
 
     fits = []
     for split_seed in split_seeds:
         train, validation, held_out = three_way_split(episodes, np.random.default_rng(split_seed))
         for fit_seed in fit_seeds:
-            start = np.random.default_rng([split_seed, fit_seed]).normal(0.0, 1.0, len(episodes[0].feature_names))
+            names = episodes[0].feature_names
+            start = np.random.default_rng([split_seed, fit_seed]).normal(0.0, 1.0, len(names))
+            sign_of = dict(signs)
+            start = np.array([sign_of[n] * abs(x) if n in sign_of else x for n, x in zip(names, start)])
             for policy in policies:
-                config = IrlConfig(max_iterations=iterations, seed=fit_seed, policy=policy, select_by="log_likelihood")
+                config = IrlConfig(max_iterations=iterations, seed=fit_seed, policy=policy, select_by="log_likelihood",
+                                   signs=tuple(signs))
                 result = fit_maxent_irl(train, validation, config, initial_weights=start)
                 names = result.weights.feature_names
                 # an unidentified feature's weight stayed at its random start: it is reported and left at 0

@@ -226,10 +226,11 @@ class ImitationWeights:
 
 def learn_imitation_weights(demos: str | Path, split_seeds=(0, 1, 2), fit_seeds=(0, 1, 2, 3, 4),
                             iterations: int = 100, features: str = "habits",
-                            context: dict | None = None) -> ImitationWeights:
+                            context: dict | None = None, signs=()) -> ImitationWeights:
     """Issue 27's protocol (``learning.irl.imitation``): per-turn MaxEnt fits over every split and fit seed, the
     shipped fit chosen by the fixed rule, and a report of every fit's held-out imitation beside the baselines
-    (always quiet, uniform random) and the same protocol on the thesis's seven features."""
+    (always quiet, uniform random) and the same protocol on the thesis's seven features. ``signs`` ((feature,
+    +1 | -1) pairs, issue 39) constrain the fit's weights; the report then adds the same protocol without them."""
     started = time.perf_counter()
     from learning.irl.imitation import baseline_scores, fit_protocol, select_features, shipped_fit, spread
 
@@ -237,7 +238,7 @@ def learn_imitation_weights(demos: str | Path, split_seeds=(0, 1, 2), fit_seeds=
     if len(episodes) < 3:
         raise DataFileError(f"--demos {demos}: the imitation fit splits the demonstrations three ways (train, "
                             f"validation, held out) and needs at least 3 episodes, got {len(episodes)}")
-    fits = fit_protocol(episodes, split_seeds, fit_seeds, iterations=iterations)
+    fits = fit_protocol(episodes, split_seeds, fit_seeds, iterations=iterations, signs=signs)
     kept = shipped_fit(fits)
     chosen = [f for f in fits if f.policy == kept.policy]
     by_name = {e.name: e for e in episodes}
@@ -250,7 +251,15 @@ def learn_imitation_weights(demos: str | Path, split_seeds=(0, 1, 2), fit_seeds=
         same_form = [f for f in seven_fits if f.policy == seven_kept.policy]
         seven = {"policy": seven_kept.policy, "held_out": spread(same_form),
                  "kept_held_out": seven_kept.held_out_scores}
+    without_signs = None
+    if signs:
+        free_fits = fit_protocol(episodes, split_seeds, fit_seeds, iterations=iterations)
+        free_kept = shipped_fit(free_fits)
+        without_signs = {"policy": free_kept.policy, "weights": free_kept.weights.as_dict(),
+                         "held_out": spread([f for f in free_fits if f.policy == free_kept.policy]),
+                         "kept_held_out": free_kept.held_out_scores}
     report = {"features": list(episodes[0].feature_names), "policy": kept.policy,
+              "signs": {name: (">= 0" if sign > 0 else "<= 0") for name, sign in signs},
               "kept": {"split_seed": kept.split_seed, "fit_seed": kept.fit_seed, "best_iteration": kept.best_iteration,
                        "validation": kept.validation_scores, "held_out": kept.held_out_scores},
               "held_out_spread": spread(chosen), "validation_spread": spread(chosen, "validation_scores"),
@@ -260,7 +269,7 @@ def learn_imitation_weights(demos: str | Path, split_seeds=(0, 1, 2), fit_seeds=
                                           for score in ("exact_agreement", "ask_or_quiet_agreement")}
                                    for bases in [[baseline_scores([by_name[n] for n in f.held_out]) for f in chosen]]
                                    for name in ("always_quiet", "uniform_random")},
-              "thesis_features_per_turn_fit": seven,
+              "thesis_features_per_turn_fit": seven, "same_features_without_signs": without_signs,
               "fits": [{"split_seed": f.split_seed, "fit_seed": f.fit_seed, "policy": f.policy,
                         "validation_log_likelihood": f.validation_scores["log_likelihood"],
                         **{f"held_out_{k}": v for k, v in f.held_out_scores.items()}} for f in fits]}
@@ -272,6 +281,7 @@ def learn_imitation_weights(demos: str | Path, split_seeds=(0, 1, 2), fit_seeds=
                   "demos": SHIPPED if str(demos) == SHIPPED else str(demos),
                   "demonstrations": demonstration_files(demos),
                   **{k: v for k, v in (context or {}).items() if k != "commit"},
+                  **({"signs": ", ".join(f"{n} {'>=' if v > 0 else '<='} 0" for n, v in signs)} if signs else {}),
                   "split_seeds": ", ".join(map(str, split_seeds)), "fit_seeds": ", ".join(map(str, fit_seeds)),
                   "kept_split_seed": kept.split_seed, "kept_fit_seed": kept.fit_seed,
                   "max_iterations": iterations, "best_iteration": kept.best_iteration,

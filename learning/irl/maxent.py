@@ -57,6 +57,7 @@ class IrlConfig:
     threads: int = 1  # torch and BLAS threads during the fit; the arrays are tiny, more threads only contend
     select_by: str = "agreement"  # keep the iterate best on validation by "agreement" or "log_likelihood"
     policy: str = "softmax"  # "softmax" over all candidates, or "gated": ask-or-not, then which query (see below)
+    signs: tuple[tuple[str, int], ...] = ()  # (feature, +1 | -1): that weight is kept >= 0 | <= 0 (issue 39)
 
     def __post_init__(self) -> None:
         if isinstance(self.max_iterations, bool) or not isinstance(self.max_iterations, int) \
@@ -76,6 +77,20 @@ class IrlConfig:
             raise ValueError(f"unknown select_by {self.select_by!r}; accepted: {', '.join(SELECTION_CRITERIA)}")
         if self.optimizer == "adam" and self.learning_rate <= 0:
             raise ValueError("learning_rate must be > 0 for the adam optimizer")
+        for entry in self.signs:
+            if not (isinstance(entry, tuple) and len(entry) == 2 and isinstance(entry[0], str)
+                    and entry[1] in (1, -1) and not isinstance(entry[1], bool)):
+                raise ValueError(f"signs must be (feature name, +1 or -1) pairs, got {entry!r}")
+
+    def bounds(self, names: Sequence[str]) -> list[tuple[float | None, float | None]]:
+        """L-BFGS-B bounds per feature from ``signs`` (the standardised weights share the raw ones' signs)."""
+        signs = dict(self.signs)
+        unknown = sorted(set(signs) - set(names))
+        if unknown:
+            raise ValueError(f"signs name {', '.join(unknown)}, which the demonstrations do not record; they record "
+                             f"{', '.join(names)}")
+        return [(0.0, None) if signs.get(n) == 1 else (None, 0.0) if signs.get(n) == -1 else (None, None)
+                for n in names]
 
 
 class PaddedTurns:
@@ -280,6 +295,8 @@ def _fit_per_turn(train, validation, config: IrlConfig, initial_weights) -> IrlR
     w0 = np.zeros(len(names)) if initial_weights is None else np.asarray(initial_weights, dtype=np.float64)
     if w0.shape != (len(names),) or not np.all(np.isfinite(w0)):
         raise ValueError(f"initial_weights must be {len(names)} finite numbers, got shape {w0.shape}")
+    bounds = config.bounds(names)
+    w0 = project(w0, bounds)  # a start outside the signs begins at the nearest weights inside them
     data = _TorchTurns(train_turns, scale, identifiable, config.policy)
     held_out = _TorchTurns(validation_turns, scale, policy=config.policy) if validation_turns is not None else None
     penalised = identifiable.astype(np.float64)
@@ -314,7 +331,7 @@ def _fit_per_turn(train, validation, config: IrlConfig, initial_weights) -> IrlR
     x0 = w0 * scale
     score(x0)
     if config.optimizer == "lbfgs":
-        outcome = minimize(value_and_gradient, x0, jac=True, method="L-BFGS-B", callback=score,
+        outcome = minimize(value_and_gradient, x0, jac=True, method="L-BFGS-B", callback=score, bounds=bounds,
                            options={"maxiter": config.max_iterations, "maxcor": 20, "ftol": config.tolerance,
                                     "gtol": config.tolerance})
         iterations, converged = len(history) - 1, bool(outcome.success)
@@ -322,7 +339,7 @@ def _fit_per_turn(train, validation, config: IrlConfig, initial_weights) -> IrlR
         adam, x, converged = AdamAscent(config.learning_rate), x0.copy(), False
         for _ in range(config.max_iterations):
             loss, gradient = value_and_gradient(x)
-            x = adam.step(x, -gradient)
+            x = project(adam.step(x, -gradient), bounds)
             score(x)
             if np.abs(gradient).max() <= config.tolerance:
                 converged = True
@@ -331,8 +348,17 @@ def _fit_per_turn(train, validation, config: IrlConfig, initial_weights) -> IrlR
     best_w, best_iteration = best["w"], best["iteration"]
     settings = {"method": "maxent-irl-per-turn", "policy": config.policy, "optimizer": config.optimizer,
                 "l2": float(config.l2), "select_by": config.select_by}
+    if config.signs:
+        settings["signs"] = ", ".join(f"{n} {'>=' if sign > 0 else '<='} 0" for n, sign in config.signs)
     return make_result(names, best_w, identifiable, history, best_iteration, iterations, converged, settings,
                        train_turns, validation_turns, started)
+
+
+def project(w: np.ndarray, bounds: Sequence[tuple[float | None, float | None]]) -> np.ndarray:
+    """w clipped into the sign bounds (a weight on the wrong side becomes 0)."""
+    low = np.array([-np.inf if lo is None else lo for lo, _ in bounds])
+    high = np.array([np.inf if hi is None else hi for _, hi in bounds])
+    return np.clip(w, low, high)
 
 
 def make_result(names: tuple[str, ...], w: np.ndarray, identifiable: np.ndarray,

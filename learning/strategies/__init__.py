@@ -16,7 +16,8 @@ dt-iros    DT on ACD and CDU (thesis ch. 6)
 dt-task    DT on ACD, CDU, IV and PM (thesis ch. 7)
 dt-iros-v1 dt-iros's hand-set weights from before the calibration rule (docs/calibration.md)
 dt-task-v1 dt-task's hand-set weights from before the calibration rule (docs/calibration.md)
-dt-task-env DT on the seven decision features and the expert-habit ones (thesis ch. 7; IRL weights, issue 27)
+dt-task-env DT-task-env on the thesis's seven features, per-turn IRL with the thesis's signs (thesis ch. 7; issue 39)
+dt-task-env-v1 DT on the seven decision features and the expert-habit ones (issue 27's IRL fit)
 dt-task-env-thesis DT-task-env on the thesis's seven features only (the earlier trajectory-level IRL fit)
 dt-task-env-no-env ablation: dt-task-env's weights without the environment features (docs/irl.md)
 dt-task-habits ablation: DT-task's learning weights with dt-task-env's habit-feature weights (docs/irl.md)
@@ -64,6 +65,7 @@ STRATEGIES: dict[str, Callable[..., Strategy]] = {
     "dt-iros-v1": partial(DecisionTheoreticStrategy, "dt-iros-v1"),
     "dt-task-v1": partial(DecisionTheoreticStrategy, "dt-task-v1"),
     "dt-task-env": partial(DecisionTheoreticStrategy, "dt-task-env"),
+    "dt-task-env-v1": partial(DecisionTheoreticStrategy, "dt-task-env-v1"),
     "dt-task-env-thesis": partial(DecisionTheoreticStrategy, "dt-task-env-thesis"),
     "dt-task-env-no-env": partial(DecisionTheoreticStrategy, "dt-task-env-no-env"),
     "dt-task-habits": partial(DecisionTheoreticStrategy, "dt-task-habits"),

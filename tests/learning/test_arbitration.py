@@ -20,7 +20,7 @@ TASK = SyntheticTask(n_features=10, n_informative=3, seed=1)
 def test_every_strategy_name_is_registered():
     assert STRATEGY_NAMES == ("passive", "active", "random", "hfs-passive", "hfs-active", "all-cd", "dt", "dt-iros",
                               "dt-task", "dt-iros-v1", "dt-task-v1",
-                              "dt-task-env", "dt-task-env-thesis", "dt-task-env-no-env", "dt-task-habits",
+                              "dt-task-env", "dt-task-env-v1", "dt-task-env-thesis", "dt-task-env-no-env", "dt-task-habits",
                               "scripted-expert", "passive-fs", "active-fs", "dt-voi")
     for name in STRATEGY_NAMES:
         assert make_strategy(name).name == name
@@ -111,10 +111,10 @@ def test_dt_treats_expected_utilities_closer_than_its_resolution_as_equal():
 
 def test_dt_chooses_what_its_expected_features_say():
     state = random_state(TASK, 10, 5, np.random.default_rng(5))
-    strategy = make_strategy("dt-task-env")
+    strategy = make_strategy("dt-task-env-v1")
     decision = strategy.choose(state, np.random.default_rng(0))
-    candidates = expected_decision_features(state, habits=True)  # dt-task-env weighs the expert-habit features too
-    expected_choice = candidates.actions[choose_index(candidates.utilities(preset_weights("dt-task-env")))]
+    candidates = expected_decision_features(state, habits=True)  # dt-task-env-v1 weighs the expert-habit features too
+    expected_choice = candidates.actions[choose_index(candidates.utilities(preset_weights("dt-task-env-v1")))]
     assert decision.action == expected_choice
     np.testing.assert_allclose(strategy.last_candidates.expected, candidates.expected)
 
@@ -142,7 +142,7 @@ def test_weight_presets_load_and_bad_weights_are_explained(tmp_path):
     for name in PRESETS:
         weights = preset_weights(name)
         assert weights.shape in ((len(FEATURE_NAMES),), (len(EXTENDED_FEATURE_NAMES),)) and np.all(np.isfinite(weights))
-    assert preset_weights("dt-task-env").shape == (len(EXTENDED_FEATURE_NAMES),)
+    assert preset_weights("dt-task-env-v1").shape == (len(EXTENDED_FEATURE_NAMES),)
     assert preset_weights("dt-task-env-thesis").shape == (len(FEATURE_NAMES),)  # the thesis's seven, unchanged
     assert np.count_nonzero(preset_weights("dt-iros")[2:]) == 0
     assert np.count_nonzero(preset_weights("dt-task")[4:]) == 0

@@ -179,6 +179,8 @@ def test_padded_choices_match_the_reference_rule():
     ({"threads": 0}, "threads must be an integer >= 1"),
     ({"select_by": "accuracy"}, "unknown select_by 'accuracy'; accepted: agreement, log_likelihood"),
     ({"optimizer": "adam", "learning_rate": 0.0}, "learning_rate must be > 0"),
+    ({"signs": (("budget_consumption", 2),)}, "signs must be"),
+    ({"signs": (("budget_consumption", True),)}, "signs must be"),
 ])
 def test_a_bad_config_is_refused(kwargs, message):
     with pytest.raises(ValueError, match=message):
@@ -267,3 +269,26 @@ def test_a_failed_weights_write_keeps_the_old_file(tmp_path, monkeypatch):
     assert path.read_text() == before
     assert sorted(p.name for p in tmp_path.iterdir()) == ["w.toml"]
     assert load_weights(path).feature_names == weights.feature_names
+
+
+# -- issue 39: the thesis's roles of the features as sign constraints --------------------------------------------
+@pytest.mark.parametrize("optimizer", ["lbfgs", "adam"])
+def test_sign_constraints_hold_and_bind_where_the_data_disagree(dt_expert, optimizer):
+    """The expert dislikes spending (w_bc = -1.5): asking for w_bc >= 0 pins it at 0; the free weights keep their
+    signs, and the constraint the data agree with (non-query time <= 0) changes nothing's sign."""
+    train, validation, _ = dt_expert
+    names = DT_TASK_ENV_FEATURES
+    free = fit_maxent_irl(train, validation, IrlConfig(optimizer=optimizer, learning_rate=0.3)).weights.values
+    signs = (("budget_consumption", 1), ("non_query_time", -1))
+    bound = fit_maxent_irl(train, validation, IrlConfig(optimizer=optimizer, learning_rate=0.3, signs=signs),
+                           initial_weights=np.full(7, -1.0))
+    w = dict(zip(names, bound.weights.values))
+    assert free[names.index("budget_consumption")] < 0
+    assert w["budget_consumption"] == 0.0
+    assert w["non_query_time"] <= 0.0
+    assert "budget_consumption >= 0" in bound.weights.provenance["signs"]
+
+
+def test_signs_must_name_recorded_features(dt_expert):
+    with pytest.raises(ValueError, match="signs name pace, which the demonstrations do not record"):
+        fit_maxent_irl(dt_expert[0][:2], config=IrlConfig(signs=(("pace", 1),)))
