@@ -45,3 +45,18 @@ def test_every_fit_of_the_protocol_keeps_the_signs():
         assert all(w[name] >= 0 for name, sign in signs if sign > 0), w
         assert all(w[name] <= 0 for name, sign in signs if sign < 0), w
     assert shipped_fit(fits).held_out_scores["exact_agreement"] >= 0.8
+
+
+def test_the_shipped_dt_task_env_is_the_plans_fit():
+    """dt-task-env weighs the seven features with the plan's signs and says where it came from."""
+    from learning.decision.weights import WEIGHTS_DIRECTORY
+    from learning.decision.weights_file import load_weights
+
+    shipped = load_weights(WEIGHTS_DIRECTORY / "dt-task-env.toml")
+    assert shipped.feature_names == FEATURE_NAMES
+    w = shipped.as_dict()
+    for name, sign in PLAN["signs"].items():
+        assert w[name] * sign >= 0, (name, w[name])
+    assert w["budget_consumption"] < 0  # the prediction's part (a): a cost on spending, not at its bound
+    assert shipped.provenance["plan"] == "learning/irl/fit-plan-dt-task-env.toml"
+    assert "budget_consumption <= 0" in shipped.provenance["signs"]
