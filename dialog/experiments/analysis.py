@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from collections import defaultdict
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -126,8 +126,8 @@ def evaluate_findings(summaries: list[CheckpointSummary], suite: Suite) -> list[
             continue
         better = lookup[(finding.condition, finding.better)]
         column = better.checkpoints.index(finding.at)
-        comparisons = tuple(compare(better, lookup[(finding.condition, other)], column, finding.alternative)
-                            for other in finding.than)
+        comparisons = tuple(compare(better, lookup[(finding.condition, other)], column, finding.alternative,
+                                    finding.margin) for other in finding.than)
         outcomes.append(FindingResult(finding, comparisons))
         tested.append(len(outcomes) - 1)
     adjusted = iter(holm([c for index in tested for c in outcomes[index].comparisons]))
@@ -138,9 +138,11 @@ def evaluate_findings(summaries: list[CheckpointSummary], suite: Suite) -> list[
 
 
 def compare(first: CheckpointSummary, second: CheckpointSummary, column: int,
-            alternative: str = "two-sided") -> Comparison | PairedComparison:
+            alternative: str = "two-sided", margin: float = 0.0) -> Comparison | PairedComparison:
     """``first`` against ``second`` at one checkpoint: paired over their shared episodes where both have episode
-    keys, else Mann-Whitney U over the episodes that reached it.
+    keys, else Mann-Whitney U over the episodes that reached it. With a ``margin`` (non-inferiority) the test
+    is of ``first`` + margin against ``second``; the means, differences and interval reported are the
+    strategies' own (without the margin), the effect r is the tested one's.
 
     The paired interval resamples whole data seeds: the episodes of one data seed share its rendered data and
     its one test pool, so they are one cluster (``PairedComparison.clusters`` says how many; with a single
@@ -150,11 +152,17 @@ def compare(first: CheckpointSummary, second: CheckpointSummary, column: int,
         theirs = {key: value for key, value in zip(second.keys, second.values[:, column]) if np.isfinite(value)}
         shared = [key for key in first.keys if key in mine and key in theirs]
         if shared:
-            return wilcoxon_paired(first.strategy, [mine[k] for k in shared], second.strategy,
-                                   [theirs[k] for k in shared], alternative, clusters=[k[0] for k in shared],
-                                   rng=np.random.default_rng(BOOTSTRAP_SEED))
-    return mann_whitney(first.strategy, _finite(first.values[:, column]), second.strategy,
-                        _finite(second.values[:, column]), alternative)
+            tested = wilcoxon_paired(first.strategy, [mine[k] + margin for k in shared], second.strategy,
+                                     [theirs[k] for k in shared], alternative, clusters=[k[0] for k in shared],
+                                     rng=np.random.default_rng(BOOTSTRAP_SEED))
+            if not margin:
+                return tested
+            ci = None if tested.ci is None else (tested.ci[0] - margin, tested.ci[1] - margin)
+            return replace(tested, mean_a=tested.mean_a - margin, median_difference=tested.median_difference - margin,
+                           ci=ci)
+    tested = mann_whitney(first.strategy, _finite(first.values[:, column]) + margin, second.strategy,
+                          _finite(second.values[:, column]), alternative)
+    return replace(tested, mean_a=tested.mean_a - margin) if margin else tested
 
 
 def _untestable(finding: Finding, lookup: dict, suite: Suite) -> str:

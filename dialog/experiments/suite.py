@@ -71,7 +71,7 @@ class Finding:
     than: tuple[str, ...]
     alternative: str = "greater"
     than_at: int | None = None  # recipes suites: compare with ``than`` at this checkpoint instead of ``at``
-    margin: float = 0.0         # recipes suites: ``better`` + margin beats ``than`` (non-inferiority)
+    margin: float = 0.0         # ``better`` + margin beats ``than``: non-inferiority (issue 40: episodes suites too)
 
 
 @dataclass(frozen=True)
@@ -344,10 +344,11 @@ def _options(table: dict, kind: str, where: str) -> dict:
 
 
 def _recipe_finding_extras(table: dict, kind: str, where: str) -> tuple[int | None, float]:
-    """``than_at`` and ``margin`` of a finding: only a recipes suite compares across checkpoints."""
+    """``than_at`` and ``margin`` of a finding: only a recipes suite compares across checkpoints; a margin
+    (non-inferiority: ``better`` + margin beats ``than``) is accepted by every kind."""
+    margin = number(table, "margin", where, 0.0, low=0.0)
     if kind != "recipes":
-        extra = [key for key in ("than_at", "margin") if key in table]
-        if extra:
-            raise SuiteError(f"{where}: '{extra[0]}' is only accepted in a suite of kind 'recipes'")
-        return None, 0.0
-    return integer(table, "than_at", where, None, low=0), number(table, "margin", where, 0.0, low=0.0)
+        if "than_at" in table:
+            raise SuiteError(f"{where}: 'than_at' is only accepted in a suite of kind 'recipes'")
+        return None, margin
+    return integer(table, "than_at", where, None, low=0), margin

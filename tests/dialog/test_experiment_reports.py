@@ -276,3 +276,36 @@ def test_the_interval_resamples_data_seeds_and_names_how_many(tmp_path):
     report = markdown_report(suite, results, summaries, evaluate_findings(summaries, suite), 1.0, tmp_path,
                              []).read_text()
     assert "(2 clusters)" in report and "none (1 cluster)" not in report
+
+
+def test_a_margin_makes_a_paired_non_inferiority_test_and_reports_the_strategies_own_means():
+    """Issue 40's findings: "not worse than, margin 0.01" tests first + 0.01 > second. A strategy 0.005 behind on
+    every one of 25 pairs is non-inferior with the margin and not better without it; 0.02 behind fails both."""
+    from dialog.experiments.analysis import CheckpointSummary
+
+    keys = tuple((seed, dataset, 0) for seed in range(5) for dataset in range(5))
+    base = np.linspace(0.6, 0.9, 25)[:, None]
+    jitter = np.random.default_rng(0).uniform(-0.001, 0.001, (25, 1))
+
+    def summary(name, values):
+        return CheckpointSummary("c", name, (40,), values.mean(axis=0), values.std(axis=0), values, keys)
+
+    other = summary("other", base)
+    close, far = summary("close", base - 0.005 + jitter), summary("far", base - 0.02 + jitter)
+    with_margin = compare(close, other, 0, "greater", margin=0.01)
+    assert with_margin.significant and abs(with_margin.mean_a - close.mean[0]) < 1e-12
+    assert with_margin.ci is not None and with_margin.ci[1] < 0  # the strategies' own difference: behind
+    assert not compare(close, other, 0, "greater").significant
+    assert not compare(far, other, 0, "greater", margin=0.01).significant
+
+
+def test_an_episodes_suite_accepts_a_margin_but_not_than_at(tmp_path):
+    text = suite_file(tmp_path).read_text()
+    assert "[[finding]]" in text
+    with_margin = text.replace("[[finding]]", "[[finding]]\nmargin = 0.01", 1)
+    path = tmp_path / "margin.toml"
+    path.write_text(with_margin)
+    assert load_suite(path).findings[0].margin == 0.01
+    path.write_text(text.replace("[[finding]]", "[[finding]]\nthan_at = 10", 1))
+    with pytest.raises(SuiteError, match="'than_at' is only accepted"):
+        load_suite(path)
