@@ -43,11 +43,14 @@ from dialog.experiments.doc_tables import (  # noqa: E402
     verdict_words,
 )
 from dialog.experiments.progress import SweepProgress, relay  # noqa: E402
+from dialog.experiments.record import RECORD_FILE, STATUS_DOCS, record_status, rewrite, status_text, write_record  # noqa: E402
 from dialog.experiments.runner import episode_specs  # noqa: E402
 from dialog.experiments.suite import load_suite  # noqa: E402
 from learning.errors import SettingsError  # noqa: E402
 
 CODE = ("learning", "dialog", "bullet_world", "robot", "pyproject.toml")
+DEFAULT_PLAN = ROOT / "docs" / "experiments.toml"
+DEMO_SHARE_COLUMNS = ("dt-iros", "dt-iros-v1", "dt-task", "dt-task-v1", "dt-task-env", "dt-task-env-v1", "dt-voi")
 
 
 def git(*words: str) -> str:
@@ -197,15 +200,21 @@ def summary_findings(plan: Plan, replications: dict, reports: dict) -> str:
 
 
 def demo_shares(plan: Plan, replications: dict) -> str:
-    """DT's demonstration share per condition beside the thesis's figure (§6.6)."""
-    lines = ["| suite / condition | thesis (DT) | dt-iros | dt-task | dt-task-env |", "|---|---:|---:|---:|---:|"]
-    for key, thesis in plan.thesis_demo_share.items():
+    """DT's demonstration share per condition beside the thesis's figure for that condition (§6.6), one column
+    per DT strategy the runs played (the old presets and dt-voi too, where a plan runs them)."""
+    shares = {}
+    for key in plan.thesis_demo_share:
         suite, _, condition = key.partition("/")
         rows = next((c["strategies"] for c in replications.get(suite, {}).get("conditions", [])
                      if c["name"] == condition), [])
-        share = {r["strategy"]: r["pooled"]["demo_share"] for r in rows}
+        shares[key] = {r["strategy"]: r["pooled"]["demo_share"] for r in rows}
+    played = {name for share in shares.values() for name in share}
+    columns = [name for name in DEMO_SHARE_COLUMNS if name in played] or list(DEMO_SHARE_COLUMNS[::2][:3])
+    lines = ["| suite / condition | thesis (DT) | " + " | ".join(columns) + " |", "|---|---:|" + "---:|" * len(columns)]
+    for key, thesis in plan.thesis_demo_share.items():
+        share = shares[key]
         lines.append(f"| {key} | {thesis:.0%} | " + " | ".join(
-            f"{share[s]:.0%}" if s in share else "–" for s in ("dt-iros", "dt-task", "dt-task-env")) + " |")
+            f"{share[s]:.0%}" if s in share else "–" for s in columns) + " |")
     return "\n".join(lines)
 
 
@@ -248,9 +257,22 @@ def render(plan: Plan, manifest: dict, out: Path) -> list[str]:
     return written
 
 
+def mark_record(manifest: dict) -> list[str]:
+    """After a whole run of the docs' plan: the record file (commit and fingerprint, dialog/experiments/record.py)
+    and the status in words in the README and docs/experiments.md."""
+    write_record(manifest["commit"], manifest["date"])
+    words = status_text(record_status())
+    written = [str(RECORD_FILE.relative_to(ROOT))]
+    for doc in STATUS_DOCS:
+        path = ROOT / doc
+        path.write_text(rewrite(path.read_text(encoding="utf-8"), words), encoding="utf-8")
+        written.append(f"{doc}: record status")
+    return written
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--plan", type=Path, default=ROOT / "docs" / "experiments.toml")
+    parser.add_argument("--plan", type=Path, default=DEFAULT_PLAN)
     parser.add_argument("--results", type=Path, default=ROOT / "results" / "experiments")
     parser.add_argument("--render", action="store_true", help="only rewrite the tables from the last run's files")
     parser.add_argument("--suites", nargs="+", default=None, help="only these runs of the plan")
@@ -274,6 +296,9 @@ def main(argv: list[str] | None = None) -> int:
             manifest = run_all(plan, args.suites, args.results, args.allow_dirty, not args.no_progress)
         for line in render(plan, manifest, args.results):
             print(f"wrote {line}")
+        if not args.render and not args.suites and args.plan.resolve() == DEFAULT_PLAN and not manifest.get("dirty"):
+            for line in mark_record(manifest):
+                print(f"wrote {line}")
     except SettingsError as error:
         print(f"experiments: {error}", file=sys.stderr)
         return 2

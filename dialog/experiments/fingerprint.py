@@ -64,7 +64,8 @@ def fingerprint_episodes(path: Path = EPISODES_FILE, transcripts: Path = Path(".
         for strategy in texts(group, "strategies", where, nonempty=True):
             for dataset in datasets:
                 label = f"{name}/{strategy}/d{dataset}"
-                transcript = transcripts / name / f"{strategy.replace('+', '-')}-d{dataset}.jsonl"
+                file_name = "".join(c if c.isalnum() or c in "-_." else "-" for c in strategy)  # rl:a/b.toml too
+                transcript = transcripts / name / f"{file_name}-d{dataset}.jsonl"
                 spec = EpisodeSpec(suite=f"fingerprint-{name}", task=text(group, "task", where),
                                    kitchen=text(group, "kitchen", where), strategy=strategy, condition=condition,
                                    dataset=dataset, seed=0, costs=costs, teacher=(), transcript=str(transcript))

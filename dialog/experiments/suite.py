@@ -25,6 +25,8 @@ AXES = ("questions", "turns", "demonstrations", "seconds")
 SUITE_FIELDS = ("name", "description", "analysis", "kind", "task", "kitchen", "strategies", "datasets", "seeds",
                 "checkpoints", "axis", "costs", "teacher", "options", "dataset", "data_seed", "condition", "finding",
                 "objects_per_scene")
+# a suite that extends another (issue 39's pre-registered run): the other's suite with more strategies and findings
+EXTENSION_FIELDS = ("extends", "name", "description", "analysis", "add_strategies", "finding")
 CONDITION_FIELDS = ("name", "budget", "turns", "change_every")
 # seconds: embodied costs' time allocation (turns is then the cap); objects_per_scene: the scene size (thesis §6.5)
 # teacher: the scripted teacher's options for this condition, over the suite's [teacher] (a sweep of them)
@@ -171,11 +173,35 @@ def load_suite(name_or_path: str | Path, known_strategies=None) -> Suite:
     table = _read(path)
     where = str(path)
     try:
+        if "extends" in table:
+            table = _extended(table, where)
         return _suite(table, where, known_strategies)
     except SuiteError:
         raise
     except DataFileError as error:
         raise SuiteError(str(error)) from None
+
+
+def _extended(table: dict, where: str) -> dict:
+    """``extends = "NAME"``: suite NAME's table with this file's name, description and analysis, its strategies
+    followed by ``add_strategies`` and its findings by this file's; nothing else can change (the same
+    conditions, data, costs and checkpoints), so the extension's episodes are the base suite's."""
+    check_keys(table, where, required=("extends", "name"), optional=EXTENSION_FIELDS)
+    base_name = text(table, "extends", where)
+    if base_name not in suite_names():
+        raise SuiteError(f"{where}: extends '{base_name}', which is not a suite{did_you_mean(base_name, suite_names())}"
+                         f"; available: {', '.join(suite_names())}")
+    base = _read(SUITE_DIR / f"{base_name}.toml")
+    if "extends" in base:
+        raise SuiteError(f"{where}: extends '{base_name}', which itself extends another suite; extend the base suite")
+    added = texts(table, "add_strategies", where, (), nonempty=False)
+    repeated = [s for s in added if s in base.get("strategies", [])]
+    if repeated:
+        raise SuiteError(f"{where}: add_strategies repeats {repeated}, already in suite '{base_name}'")
+    merged = {**base, **{k: table[k] for k in ("name", "description", "analysis") if k in table}}
+    merged["strategies"] = [*base.get("strategies", []), *added]
+    merged["finding"] = [*base.get("finding", []), *table.get("finding", [])]
+    return merged
 
 
 def _suite(table: dict, where: str, known_strategies) -> Suite:

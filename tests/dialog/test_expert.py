@@ -45,7 +45,7 @@ def test_the_scripted_expert_follows_its_documented_rules(tmp_path, seed):
 def test_recorded_features_are_what_the_dt_strategy_computes(tmp_path):
     from learning.strategies import make_strategy
 
-    dt = make_strategy("dt-task-env")
+    dt = make_strategy("dt-task-env-v1")  # the eleven features the expert records
 
     class Checking(ScriptedExpertChooser):
         checked = 0

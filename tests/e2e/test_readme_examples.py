@@ -36,8 +36,6 @@ SKIPPED = {
     "teachbot view --task pack-lunchbox --seed 0": "serves the viewer until Ctrl-C, as the README says",
     "teachbot regress --suite ch6-dynamic": "runs long (the chapter-6 suite, minutes on every core)",
     "teachbot regress --suite recipes": "runs long (2,040 recipe trials)",
-    "teachbot regress --suite ch7-irl --data-seeds 0 1 --seeds 0 1 2 3 4":
-        "runs long (1,200 episodes, about 11 minutes on 2 cores: the pre-registered chapter-7 evaluation, run once)",
     "teachbot learn-weights --demos shipped --out w.toml --json":
         "runs long (trajectory IRL: 100 iterations of dialog rollouts, about 10 minutes on 2 cores)",
     "teachbot train-questioner --out questioner.toml":

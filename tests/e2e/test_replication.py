@@ -113,7 +113,7 @@ def test_teach_takes_weights_with_the_expert_habit_features(tmp_path, capsys):
     teach records them in the header and resumes from it (the header check once knew only the seven)."""
     from pathlib import Path
 
-    shipped = Path(__file__).resolve().parents[2] / "learning" / "decision" / "presets" / "dt-task-env.toml"
+    shipped = Path(__file__).resolve().parents[2] / "learning" / "decision" / "presets" / "dt-task-env-v1.toml"
     path = tmp_path / "teach.jsonl"
     assert main(["teach", "--weights", str(shipped), "--turns", "4", "--budget", "8", "--change-every", "2",
                  "--transcript", str(path), "--teacher", "scripted", "--no-pictures", "--json"]) == 0

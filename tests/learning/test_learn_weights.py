@@ -10,7 +10,7 @@ from learning.decision.features import FEATURE_NAMES
 from learning.decision.weights import WEIGHTS_DIRECTORY, load_weight_file
 from learning.decision.weights_file import load_weights
 
-LEARNED = WEIGHTS_DIRECTORY / "dt-task-env.toml"  # the dt-task-env preset carries the learned weights
+LEARNED = WEIGHTS_DIRECTORY / "dt-task-env-v1.toml"  # issue 27's learned weights (dt-task-env-v1)
 
 
 def test_learn_weights_per_turn_on_the_shipped_demos_prints_the_summary(tmp_path, capsys):
