@@ -71,6 +71,9 @@ def register(commands) -> None:
                         help="instead of the progress line, one line per finished episode on standard error, "
                              "for a parent process that shows the progress of a longer run (make experiments)")
     parser.add_argument("--json", action="store_true", help="end with one JSON line summarising the run")
+    parser.add_argument("--render-only", action="store_true",
+                        help="render (or find in the cache) the data sets the run would use, for each data seed, "
+                             "and stop: no episode is played and nothing is written to the results folder")
     parser.set_defaults(handler=run)
 
 
@@ -112,6 +115,8 @@ def run(args: argparse.Namespace) -> int:
     suite = kind.load(original.with_overrides(strategies=args.strategies, seeds=args.seeds, budget=args.budget,
                                               datasets=args.datasets, data_seed=args.data_seed,
                                               embodied_seconds=_embodied_seconds(args)))
+    if args.render_only:
+        return render_only(args, kind, suite)
     if args.update_baseline:
         refuse_baseline_from_another_run(suite, original)  # before anything runs
     if args.check:
@@ -153,6 +158,32 @@ def run(args: argparse.Namespace) -> int:
         print_json({"suite": suite.name, "episodes": outcome.count, "seconds": round(outcome.seconds, 2),
                           **data, **use, "passed": not failures, "failures": failures})
     return 1 if failures else 0
+
+
+def render_only(args: argparse.Namespace, kind, suite) -> int:
+    """--render-only: the data sets of every data seed the run would use, rendered once (then cached), before a
+    long run; plays no episode, so it reads no result."""
+    import time
+
+    from dialog.experiments.pools import load_pools
+    from dialog.experiments.runner import RenderBar
+
+    for refused in ("check", "update_baseline"):
+        if getattr(args, refused):
+            raise SettingsError(f"--render-only plays no episode; --{refused.replace('_', '-')} needs a run: give "
+                                "one or the other")
+    if kind.name != "episodes":
+        raise SettingsError(f"--render-only renders the data sets of episodes suites; '{suite.name}' is a "
+                            f"{kind.name} suite")
+    for seed in dict.fromkeys(args.data_seeds or [suite.data_seed]):
+        started, what = time.perf_counter(), f"{suite.task}/{suite.kitchen} (data seed {seed})"
+        with RenderBar(what, shows_bars(args)) as bar:
+            load_pools(suite.task, suite.kitchen, suite.datasets, suite.plan_options, progress=bar, data_seed=seed)
+        print(f"{suite.name}: the data sets of {what} are ready ({time.perf_counter() - started:.0f} s)", flush=True)
+    if args.json:
+        print_json({"suite": suite.name, "data_seeds": list(dict.fromkeys(args.data_seeds or [suite.data_seed])),
+                    "rendered": True})
+    return 0
 
 
 def run_on_data_seeds(args: argparse.Namespace, kind, suite, original, out: Path) -> int:

@@ -260,3 +260,21 @@ def test_a_suite_on_several_data_seeds_reports_each_and_pooled(tmp_path, capsys)
     assert main(["regress", "--suite", str(suite), "--data-seeds", "0", "0", "--results", str(out)]) == 2
     assert "each data seed once" in capsys.readouterr().err
     assert main(["regress", "--suite", str(suite), "--data-seeds", "0", "--check", "--results", str(out)]) == 2
+
+
+def test_render_only_prepares_every_data_seed_and_plays_nothing(tmp_path, capsys, monkeypatch):
+    """Before a long run (a pre-registered one): --render-only loads (renders once) each data seed's data sets,
+    in the suite's plan, and neither plays an episode nor writes a results folder."""
+    loaded = []
+    monkeypatch.setattr("dialog.experiments.pools.load_pools",
+                        lambda task, kitchen, datasets, plan, progress=None, data_seed=0:
+                        loaded.append((task, kitchen, datasets, data_seed)))
+    suite = write_suite(tmp_path)
+    out = tmp_path / "out"
+    assert main(["regress", "--suite", str(suite), "--data-seeds", "3", "4", "--results", str(out), "--render-only",
+                 "--no-progress", "--json"]) == 0
+    assert [seed for *_, seed in loaded] == [3, 4] and not out.exists()
+    lines = capsys.readouterr().out.strip().splitlines()
+    assert "data seed 3) are ready" in lines[0] and json.loads(lines[-1])["data_seeds"] == [3, 4]
+    assert main(["regress", "--suite", str(suite), "--render-only", "--check"]) == 2
+    assert "--render-only plays no episode" in capsys.readouterr().err
