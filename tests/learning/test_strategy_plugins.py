@@ -111,7 +111,7 @@ def test_names_and_file_labels(mypkg):
         check_strategy_name("clever")
     with pytest.raises(SettingsError, match="unknown strategy 'dt-tsk' \\(did you mean 'dt-task'\\?\\)"):
         make_strategy("dt-tsk")
-    assert len(STRATEGY_NAMES) == 19  # nothing registered by loading a plugin
+    assert len(STRATEGY_NAMES) == 20  # nothing registered by loading a plugin
 
 
 def test_a_suite_accepts_a_plugin_and_refuses_a_broken_one_before_running(mypkg, tmp_path):
