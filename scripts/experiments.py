@@ -140,7 +140,7 @@ def _run_and_record(run, plan: Plan, out: Path, manifest: dict, dirty: bool, lin
     say(f"  {run.suite}: {seconds:.0f} s")
 
 
-def tables_from(plan: Plan, manifest: dict, out: Path) -> dict[str, str]:
+def tables_from(plan: Plan, manifest: dict, out: Path, command: str = "make experiments") -> dict[str, str]:
     """Every table this run can write, keyed by block name, each with its stamp."""
     tables, replications, reports = {}, {}, {}
     for run in plan.runs:
@@ -157,7 +157,7 @@ def tables_from(plan: Plan, manifest: dict, out: Path) -> dict[str, str]:
         else:
             reports[run.suite] = (folder / "report.md").read_text(encoding="utf-8")
             tables[f"{run.suite}:report"] = report_tables(reports[run.suite]) + figures + "\n\n" + line
-    overall = stamp(manifest, "make experiments")
+    overall = stamp(manifest, command)
     tables["summary:findings"] = summary_findings(plan, replications, reports) + "\n\n" + overall
     tables["summary:demo-share"] = demo_shares(plan, replications) + "\n\n" + overall
     tables["summary:wall-times"] = wall_times(manifest) + "\n\n" + overall
@@ -246,8 +246,9 @@ def wall_times(manifest: dict) -> str:
     return "\n".join(lines)
 
 
-def render(plan: Plan, manifest: dict, out: Path) -> list[str]:
-    tables = tables_from(plan, manifest, out)
+def render(plan: Plan, manifest: dict, out: Path, command: str = "make experiments") -> list[str]:
+    """Every table of the plan into its docs; ``command`` is what the summary tables' stamps name."""
+    tables = tables_from(plan, manifest, out, command)
     written = []
     for doc in plan.docs:
         path = ROOT / doc
@@ -294,7 +295,9 @@ def main(argv: list[str] | None = None) -> int:
             manifest = json.loads(manifest_path.read_text())
         else:
             manifest = run_all(plan, args.suites, args.results, args.allow_dirty, not args.no_progress)
-        for line in render(plan, manifest, args.results):
+        command = "make experiments" if args.plan.resolve() == DEFAULT_PLAN else \
+            f"python scripts/experiments.py --plan {os.path.relpath(args.plan.resolve(), ROOT)}"
+        for line in render(plan, manifest, args.results, command):
             print(f"wrote {line}")
         if not args.render and not args.suites and args.plan.resolve() == DEFAULT_PLAN and not manifest.get("dirty"):
             for line in mark_record(manifest):
