@@ -40,9 +40,9 @@ ABLATION_COMMENTS = {
                       "norm) with dt-task-env-v1's\nhabit-feature weights. Written by scripts/fit_dt_task_env.py "
                       "--eleven; docs/irl.md.",
 }
-SEVEN_COMMENT = ("DT-task-env weights (thesis eq. 7.2): per-turn maximum-entropy IRL (eq. 7.5-7.7) on the thesis's seven "
-                 "features with the thesis's signs,\nby the plan learning/irl/fit-plan-dt-task-env.toml (issue 39), "
-                 "committed before the fit. Written by scripts/fit_dt_task_env.py; docs/irl.md.")
+SEVEN_COMMENT = ("DT-task-env weights (thesis eq. 7.2): per-turn maximum-entropy IRL (eq. 7.5-7.7) on the thesis's "
+                 "seven features with the thesis's signs,\nby the plan learning/irl/fit-plan-dt-task-env.toml "
+                 "(issue 39), committed before the fit. Written by scripts/fit_dt_task_env.py; docs/irl.md.")
 
 
 def plan_signs(plan: dict) -> tuple[tuple[str, int], ...]:

@@ -19,8 +19,8 @@ TASK = SyntheticTask(n_features=10, n_informative=3, seed=1)
 
 def test_every_strategy_name_is_registered():
     assert STRATEGY_NAMES == ("passive", "active", "random", "hfs-passive", "hfs-active", "all-cd", "dt", "dt-iros",
-                              "dt-task", "dt-iros-v1", "dt-task-v1",
-                              "dt-task-env", "dt-task-env-v1", "dt-task-env-thesis", "dt-task-env-no-env", "dt-task-habits",
+                              "dt-task", "dt-iros-v1", "dt-task-v1", "dt-task-env", "dt-task-env-v1",
+                              "dt-task-env-thesis", "dt-task-env-no-env", "dt-task-habits",
                               "scripted-expert", "passive-fs", "active-fs", "dt-voi")
     for name in STRATEGY_NAMES:
         assert make_strategy(name).name == name
