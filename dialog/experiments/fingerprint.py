@@ -24,6 +24,7 @@ from learning.datafiles import check_keys, integer, number, read_toml, section, 
 from learning.errors import DataFileError
 
 DATA_DIR = Path(__file__).resolve().parents[1] / "data"
+ROOT = Path(__file__).resolve().parents[2]
 EPISODES_FILE = DATA_DIR / "fingerprint.toml"
 HASHES_FILE = DATA_DIR / "fingerprint-transcripts.json"
 GROUP_FIELDS = ("name", "task", "kitchen", "strategies", "datasets", "costs", "budget", "turns", "change_every")
@@ -77,6 +78,12 @@ def digest(data: bytes) -> str:
     return hashlib.sha256(data).hexdigest()
 
 
+def located_nowhere(transcript: bytes) -> bytes:
+    """A transcript with the checkout's own folder written as ``<repo>``: an RL policy's file is recorded by its
+    absolute path, which says where the clone is, not what the code decided."""
+    return transcript.replace(str(ROOT).encode(), b"<repo>")
+
+
 def fingerprint(path: Path = EPISODES_FILE) -> dict[str, dict[str, str]]:
     """Run every fixed episode; {label: {"transcript": sha256 of its file, "series": sha256 of its series}}."""
     hashes = {}
@@ -84,7 +91,7 @@ def fingerprint(path: Path = EPISODES_FILE) -> dict[str, dict[str, str]]:
         for episode in fingerprint_episodes(path, Path(folder)):
             result = run_episode(episode.spec)
             series = json.dumps({"series": result["series"], "accuracy": result["accuracy"]}, sort_keys=True)
-            hashes[episode.label] = {"transcript": digest(Path(episode.spec.transcript).read_bytes()),
+            hashes[episode.label] = {"transcript": digest(located_nowhere(Path(episode.spec.transcript).read_bytes())),
                                      "series": digest(series.encode())}
     return hashes
 

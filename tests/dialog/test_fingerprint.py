@@ -44,3 +44,11 @@ def test_a_bad_episode_list_or_recording_is_one_line(tmp_path: Path):
     with pytest.raises(DataFileError) as caught:
         recorded(broken)
     assert "\n" not in str(caught.value) and "--record" in str(caught.value)
+
+
+def test_where_the_checkout_lies_is_not_part_of_a_fingerprint():
+    """An RL policy's transcript records its file by absolute path; a fresh clone elsewhere must hash the same."""
+    from dialog.experiments.fingerprint import ROOT, located_nowhere
+
+    here = f'{{"policy": {{"file": "{ROOT}/learning/rl/policies/q.toml"}}}}'.encode()
+    assert located_nowhere(here) == b'{"policy": {"file": "<repo>/learning/rl/policies/q.toml"}}'
