@@ -43,7 +43,7 @@ from dialog.experiments.doc_tables import (  # noqa: E402
     verdict_words,
 )
 from dialog.experiments.progress import SweepProgress, relay  # noqa: E402
-from dialog.experiments.record import RECORD_FILE, STATUS_DOCS, record_status, rewrite, status_text, write_record  # noqa: E402
+from dialog.experiments.record import RECORD_FILE, STATUS_DOCS, record_status, status_text, write_record, write_status  # noqa: E402
 from dialog.experiments.runner import episode_specs  # noqa: E402
 from dialog.experiments.suite import load_suite  # noqa: E402
 from learning.errors import SettingsError  # noqa: E402
@@ -51,6 +51,7 @@ from learning.errors import SettingsError  # noqa: E402
 CODE = ("learning", "dialog", "bullet_world", "robot", "pyproject.toml")
 DEFAULT_PLAN = ROOT / "docs" / "experiments.toml"
 DEMO_SHARE_COLUMNS = ("dt-iros", "dt-iros-v1", "dt-task", "dt-task-v1", "dt-task-env", "dt-task-env-v1", "dt-voi")
+THESIS_DT = ("dt-iros", "dt-task", "dt-task-env")  # the columns of a demo-share table before any run
 
 
 def git(*words: str) -> str:
@@ -209,7 +210,7 @@ def demo_shares(plan: Plan, replications: dict) -> str:
                      if c["name"] == condition), [])
         shares[key] = {r["strategy"]: r["pooled"]["demo_share"] for r in rows}
     played = {name for share in shares.values() for name in share}
-    columns = [name for name in DEMO_SHARE_COLUMNS if name in played] or list(DEMO_SHARE_COLUMNS[::2][:3])
+    columns = [name for name in DEMO_SHARE_COLUMNS if name in played] or list(THESIS_DT)
     lines = ["| suite / condition | thesis (DT) | " + " | ".join(columns) + " |", "|---|---:|" + "---:|" * len(columns)]
     for key, thesis in plan.thesis_demo_share.items():
         share = shares[key]
@@ -262,13 +263,8 @@ def mark_record(manifest: dict) -> list[str]:
     """After a whole run of the docs' plan: the record file (commit and fingerprint, dialog/experiments/record.py)
     and the status in words in the README and docs/experiments.md."""
     write_record(manifest["commit"], manifest["date"])
-    words = status_text(record_status())
-    written = [str(RECORD_FILE.relative_to(ROOT))]
-    for doc in STATUS_DOCS:
-        path = ROOT / doc
-        path.write_text(rewrite(path.read_text(encoding="utf-8"), words), encoding="utf-8")
-        written.append(f"{doc}: record status")
-    return written
+    missing = write_status(status_text(record_status()))
+    return [str(RECORD_FILE.relative_to(ROOT)), *(f"{doc}: record status" for doc in STATUS_DOCS if doc not in missing)]
 
 
 def main(argv: list[str] | None = None) -> int:

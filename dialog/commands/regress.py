@@ -175,14 +175,14 @@ def render_only(args: argparse.Namespace, kind, suite) -> int:
     if kind.name != "episodes":
         raise SettingsError(f"--render-only renders the data sets of episodes suites; '{suite.name}' is a "
                             f"{kind.name} suite")
-    for seed in dict.fromkeys(args.data_seeds or [suite.data_seed]):
+    data_seeds = list(dict.fromkeys(args.data_seeds or [suite.data_seed]))
+    for seed in data_seeds:
         started, what = time.perf_counter(), f"{suite.task}/{suite.kitchen} (data seed {seed})"
         with RenderBar(what, shows_bars(args)) as bar:
             load_pools(suite.task, suite.kitchen, suite.datasets, suite.plan_options, progress=bar, data_seed=seed)
         print(f"{suite.name}: the data sets of {what} are ready ({time.perf_counter() - started:.0f} s)", flush=True)
     if args.json:
-        print_json({"suite": suite.name, "data_seeds": list(dict.fromkeys(args.data_seeds or [suite.data_seed])),
-                    "rendered": True})
+        print_json({"suite": suite.name, "data_seeds": data_seeds, "rendered": True})
     return 0
 
 

@@ -22,9 +22,8 @@ import sys
 from dataclasses import dataclass
 from pathlib import Path
 
-from dialog.experiments.fingerprint import HASHES_FILE, recorded
+from dialog.experiments.fingerprint import HASHES_FILE, ROOT, recorded
 
-ROOT = Path(__file__).resolve().parents[2]
 RECORD_FILE = ROOT / "docs" / "experiments-record.json"
 STATUS_DOCS = ("README.md", "docs/experiments.md")
 BEGIN, END = "<!-- record-status:begin -->", "<!-- record-status:end -->"
@@ -85,21 +84,30 @@ def rewrite(text: str, words: str) -> str:
     return BLOCK.sub(lambda _: f"{BEGIN}\n{words}\n{END}", text)
 
 
+def write_status(words: str) -> list[str]:
+    """Rewrite the status block of every doc in STATUS_DOCS with ``words``; the docs that have no block (and so
+    were left alone) are returned."""
+    missing = []
+    for doc in STATUS_DOCS:
+        path = ROOT / doc
+        text = path.read_text(encoding="utf-8")
+        if not blocks(text):
+            missing.append(doc)
+            continue
+        path.write_text(rewrite(text, words), encoding="utf-8")
+    return missing
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--write", action="store_true", help=f"rewrite the status in {' and '.join(STATUS_DOCS)}")
     args = parser.parse_args(argv)
     words = status_text(record_status())
     print(words)
-    if args.write:
-        for doc in STATUS_DOCS:
-            path = ROOT / doc
-            text = path.read_text(encoding="utf-8")
-            if not blocks(text):
-                print(f"error: {doc} has no {BEGIN} ... {END} block to rewrite", file=sys.stderr)
-                return 2
-            path.write_text(rewrite(text, words), encoding="utf-8")
-    return 0
+    missing = write_status(words) if args.write else []
+    for doc in missing:
+        print(f"error: {doc} has no {BEGIN} ... {END} block to rewrite", file=sys.stderr)
+    return 2 if missing else 0
 
 
 if __name__ == "__main__":

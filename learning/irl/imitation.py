@@ -133,13 +133,13 @@ def fit_protocol(episodes: Sequence[QuestioningEpisode], split_seeds: Sequence[i
     from learning.irl.maxent import IrlConfig, fit_maxent_irl
 
     fits = []
+    sign_of = dict(signs)
     for split_seed in split_seeds:
         train, validation, held_out = three_way_split(episodes, np.random.default_rng(split_seed))
         for fit_seed in fit_seeds:
-            names = episodes[0].feature_names
-            start = np.random.default_rng([split_seed, fit_seed]).normal(0.0, 1.0, len(names))
-            sign_of = dict(signs)
-            start = np.array([sign_of[n] * abs(x) if n in sign_of else x for n, x in zip(names, start)])
+            start = np.random.default_rng([split_seed, fit_seed]).normal(0.0, 1.0, len(episodes[0].feature_names))
+            start = np.array([sign_of[n] * abs(x) if n in sign_of else x
+                              for n, x in zip(episodes[0].feature_names, start)])
             for policy in policies:
                 config = IrlConfig(max_iterations=iterations, seed=fit_seed, policy=policy, select_by="log_likelihood",
                                    signs=tuple(signs))
