@@ -6,10 +6,12 @@
 The same scene (``teachbot view``'s: prepare-lunch in kitchen-1, seed 0) is exported twice as a
 self-contained page: once with the viewer's meshes as shipped (each OBJ mesh without texture coordinates
 simplified to bullet_world.viewer.meshes.VIEWER_TRIANGLES triangles) and once with the full meshes (the
-Panda's ~100,000 triangles). Headless Chromium, with SwiftShader (software WebGL, as on a machine
-without a GPU), draws each page's scene ``--frames`` times in a row, waiting for each frame to finish
-(a pixel read back after each); the rounds alternate the pages so that a change in the machine's load
-falls on both. Printed: triangles drawn per frame and milliseconds per frame for each, and their ratio.
+Panda's ~100,000 triangles); the simplified page is also drawn as the web page draws it in software, with
+diffuse (Lambert) materials (dialog/web/static/diffuse.js). Headless Chromium, with SwiftShader (software
+WebGL, as on a machine without a GPU), draws each page's scene ``--frames`` times in a row, waiting for
+each frame to finish (a pixel read back after each); the rounds alternate the pages so that a change in the
+machine's load falls on all. Printed: triangles drawn per frame and milliseconds per frame for each, and
+the ratios of full and diffuse to simplified.
 """
 
 from __future__ import annotations
@@ -29,12 +31,15 @@ sys.path.insert(0, str(ROOT))
 from bullet_world.viewer import meshes  # noqa: E402
 from bullet_world.viewer.snapshot import CHROMIUM_FLAGS, find_chromium  # noqa: E402
 
-DRAW = """async (frames) => {
+DIFFUSE_JS = ROOT / "dialog" / "web" / "static" / "diffuse.js"
+
+DRAW = """async ([frames, diffuse]) => {
   await new Promise((done) => { const wait = () => (viewer && viewer.scene && viewer.scene.children.length)
     ? done() : setTimeout(wait, 50); wait(); });
   const renderer = viewer.renderer, gl = renderer.getContext(), pixel = new Uint8Array(4);
   // reading a pixel back waits until the frame is really drawn (gl.finish may return at once)
   const draw = () => {
+    if (diffuse) { diffuseOnly(viewer.scene, MeshCat.THREE); }
     renderer.render(viewer.scene, viewer.camera);
     gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, pixel);
   };
@@ -88,6 +93,7 @@ def main(argv=None) -> int:
     with tempfile.TemporaryDirectory() as folder:
         pages = {"simplified": Path(folder) / "simplified.html", "full": Path(folder) / "full.html"}
         export_scene(pages["simplified"], shipped)
+        pages["diffuse"] = pages["simplified"]
         export_scene(pages["full"], None)
         meshes.VIEWER_TRIANGLES = shipped
         results: dict[str, dict] = {name: {"times": []} for name in pages}
@@ -99,7 +105,8 @@ def main(argv=None) -> int:
                         page = browser.new_page(viewport={"width": 900, "height": 600})
                         page.goto(path.as_uri(), timeout=600_000)  # the full page is large: slow to parse
                         page.set_default_timeout(600_000)
-                        drawn = page.evaluate(DRAW, args.frames)
+                        page.add_script_tag(path=str(DIFFUSE_JS))
+                        drawn = page.evaluate(DRAW, [args.frames, name == "diffuse"])
                         results[name]["triangles"] = drawn["triangles"]
                         results[name]["times"] += drawn["times"]
                         page.close()
@@ -114,12 +121,15 @@ def main(argv=None) -> int:
                          "ms_per_frame_p95": round(float(np.percentile(times, 95)), 1)}
     summary["ratio_median"] = round(summary["full"]["ms_per_frame_median"]
                                     / summary["simplified"]["ms_per_frame_median"], 2)
+    summary["diffuse_ratio_median"] = round(summary["diffuse"]["ms_per_frame_median"]
+                                            / summary["simplified"]["ms_per_frame_median"], 2)
     for name in pages:
         row = summary[name]
         print(f"{name:>10}: {row['triangles']:>7} triangles, {row['ms_per_frame_median']:.1f} ms per frame (median), "
               f"p95 {row['ms_per_frame_p95']:.1f} ms")
     print(f"full / simplified: {summary['ratio_median']:.2f}x per frame (median of {summary['frames']} frames each; "
           f"load average {summary['load_average']})")
+    print(f"diffuse / simplified: {summary['diffuse_ratio_median']:.2f}x per frame")
     if args.json:
         print(json.dumps(summary))
     return 0

@@ -53,6 +53,8 @@ def test_a_click_on_the_object_in_the_3d_view_shows_it(tmp_path):
     try:
         with chromium() as browser:
             page = open_page(browser, command.url)
+            errors: list[str] = []
+            page.on("pageerror", lambda error: errors.append(str(error)))
             question = wait_for_question(page)
             assert question["expects"] == "feature"  # all-cd asks which features matter first
             page.locator("#features input[data-number='1.1']").check()
@@ -62,12 +64,19 @@ def test_a_click_on_the_object_in_the_3d_view_shows_it(tmp_path):
             concept = question["text"].split("show me ")[1].split("?")[0].split(" ", 1)[1]
             page.wait_for_function("() => Object.keys(objectNodes).length > 0")
             time.sleep(1.0)  # the 3D view has drawn the scene
+            # headless Chromium draws WebGL in software: the view is drawn with diffuse materials (diffuse.js)
+            assert page.evaluate("software3d")
+            materials = page.evaluate("""() => { const kinds = new Set();
+                viewer.scene.traverse((node) => { if (node.isMesh) { kinds.add(node.material.type); } });
+                return [...kinds]; }""")
+            assert "MeshLambertMaterial" in materials and "MeshPhongMaterial" not in materials, materials
             box = page.locator("#view3d canvas").bounding_box()
             members = [i for i, name in enumerate(truth) if name == concept]
             nearest = min(members, key=lambda i: np.linalg.norm(centres[i] - eye))  # the least hidden one
             column, row = project(centres[nearest], eye, LOOKED_AT, box["width"], box["height"])
             page.mouse.click(box["x"] + column, box["y"] + row)
             page.wait_for_function("() => ended", timeout=60_000)
+            assert not errors, errors
         assert command.finish() == 0
     finally:
         command.stop()

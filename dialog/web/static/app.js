@@ -360,6 +360,7 @@ function throttle3d() {
       return;
     }
     last = now;
+    if (software3d) { diffuseOnly(viewer.scene, MeshCat.THREE); }
     render();
     if (waiting && question) { drawn3d = question.id; }
   };
