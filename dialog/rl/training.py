@@ -27,6 +27,9 @@ from learning.rl.policy_file import QuestionerPolicy
 
 HIDDEN = (64, 64)
 ESTIMATE_EPISODES, ESTIMATE_TURNS = 2, 60  # timed before training for the time estimate: at least this many of each
+# across allocations each episode draws its own, and a turn's cost varies several-fold between draws: two draws
+# said 117 s for a run that took 863 s (docs/rl.md), so the probe plays more of them
+ESTIMATE_EPISODES_ACROSS = 8
 
 
 @dataclass(frozen=True)
@@ -83,6 +86,7 @@ class _Progress:
         self.total, self.enabled, self.started = total, enabled, time.perf_counter()
         self.accuracies: list[float] = []
         self.episodes = 0
+        self.restated = False  # whether the estimate was said again after the first rollout
         self._bar = self._task = None
 
     def __enter__(self):
@@ -138,14 +142,16 @@ def train(config: TrainingConfig, progress: bool = True, provenance: dict | None
     probe = make_env(config.env)()  # validates the options here, once, and renders the data sets if needed
     layout = probe.layout
     loading = time.perf_counter() - started  # the training environments load the same data sets again
-    per_turn = seconds_per_turn(probe, config.seed)
+    per_turn = seconds_per_turn(probe, config.seed,
+                                episodes=ESTIMATE_EPISODES if probe.allocations is None else ESTIMATE_EPISODES_ACROSS)
     probe.close()
     so_far = time.perf_counter() - started
     estimate = so_far + loading + per_turn * config.steps / min(config.envs, os.cpu_count() or 1)
     say(f"this will take about {_duration(estimate)} in all: {so_far:.0f} s so far, {loading:.0f} s to start the "
         "environments, then "
         f"{config.steps} steps at {per_turn * 1000:.0f} ms per turn over {config.envs} environment(s) (timed on "
-        f"{ESTIMATE_EPISODES}+ whole episodes of random questions)")
+        f"{ESTIMATE_EPISODES if probe.allocations is None else ESTIMATE_EPISODES_ACROSS}+ whole episodes of random "
+        "questions)")
     say(f"starting {config.envs} environment{'s' if config.envs > 1 else ''}"
         f"{' in worker processes' if config.envs > 1 else ''}, then training...")
     vec_cls = SubprocVecEnv if config.envs > 1 else DummyVecEnv
@@ -159,11 +165,20 @@ def train(config: TrainingConfig, progress: bool = True, provenance: dict | None
             tracker.update(self.num_timesteps, self.locals["infos"], self.locals["dones"])
             return True
 
+        def _on_rollout_start(self) -> None:
+            if tracker.restated or not self.num_timesteps or self.num_timesteps >= config.steps:
+                return
+            tracker.restated = True  # once, after the first rollout and its update: a real policy's turns timed
+            spent = time.perf_counter() - training_started
+            left = spent * (config.steps - self.num_timesteps) / self.num_timesteps
+            say(f"after the first {self.num_timesteps} steps ({spent:.0f} s): about {_duration(left)} left")
+
     try:
         model = MaskablePPO("MlpPolicy", venv, n_steps=config.n_steps, batch_size=config.batch_size,
                             n_epochs=config.epochs, learning_rate=config.learning_rate, gamma=config.gamma,
                             gae_lambda=config.gae_lambda, seed=config.seed, device="cpu", verbose=0,
                             policy_kwargs={"net_arch": {"pi": list(HIDDEN), "vf": list(HIDDEN)}})
+        training_started = time.perf_counter()
         with tracker:
             model.learn(total_timesteps=config.steps, callback=Track())
     finally:

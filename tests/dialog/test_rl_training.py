@@ -106,3 +106,17 @@ def test_a_bad_out_path_is_one_line_before_any_training(tmp_path, capsys):
     assert main(["train-questioner", "--out", str(blocker / "q.toml")]) == 2
     err = capsys.readouterr().err.strip()
     assert err.count("\n") == 0 and "Traceback" not in err and str(blocker) in err
+
+
+def test_the_time_estimate_is_said_before_training_and_again_after_the_first_rollout():
+    from dialog.rl.training import TrainingConfig, train
+
+    lines: list[str] = []
+    config = TrainingConfig(steps=256, envs=1, seed=2, n_steps=64, batch_size=32, epochs=1,
+                            env={"turns": 8, "budget": 8, "change_every": 4})
+    _, summary = train(config, progress=False, say=lines.append)
+    before = [line for line in lines if line.startswith("this will take about")]
+    again = [line for line in lines if line.startswith("after the first 64 steps")]
+    assert len(before) == 1 and "timed on 2+ whole episodes" in before[0]
+    assert len(again) == 1 and again[0].endswith("left"), lines
+    assert summary["estimated_seconds"] > 0
