@@ -1,17 +1,22 @@
-"""Regenerate the pictures of the three kitchens in docs/ (docs/kitchen.md shows them).
+"""Regenerate the pictures of the three kitchens and of the teaching page in docs/ (docs/kitchen.md, docs/web.md
+and the README show them).
 
 For each kitchen: the overhead camera's annotated picture of a seeded scene with the arm
 (``docs/img/kitchens/kitchen-N-camera.png``, as `teachbot world show --png` draws it, at 3/4 size) and a view of
 the room from the teacher's side rendered by PyBullet's TinyRenderer (``docs/img/kitchens/kitchen-N-room.png``).
-Deterministic: the same seed gives the same pictures.
+Deterministic: the same seed gives the same pictures. Then, in headless Chromium (unless ``--no-page`` or there is
+no Chromium), each kitchen's 3D view as the meshcat mirror shows it (``docs/img/kitchens/kitchen-N-3d.png``,
+`teachbot view --screenshot`, at 3/4 size) and the teaching page mid-question (``docs/img/web-teach.png``, by
+scripts/web_screenshot.py: a real ``teach --web`` session).
 
-    .venv/bin/python scripts/kitchen_pictures.py [--seed 0] [--out docs/img/kitchens] [--json]
+    .venv/bin/python scripts/kitchen_pictures.py [--seed 0] [--out docs/img/kitchens] [--no-page] [--json]
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import subprocess
 import sys
 from pathlib import Path
 
@@ -51,6 +56,7 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--out", type=Path, default=ROOT / "docs" / "img" / "kitchens")
+    parser.add_argument("--no-page", action="store_true", help="not the teaching page's picture")
     parser.add_argument("--json", action="store_true")
     args = parser.parse_args(argv)
     args.out.mkdir(parents=True, exist_ok=True)
@@ -66,6 +72,24 @@ def main(argv: list[str] | None = None) -> int:
                 write_png(path, picture)
                 written.append({"kitchen": name, "picture": kind, "path": str(path.relative_to(ROOT)),
                                 "bytes": path.stat().st_size})
+    page = ROOT / "docs" / "img" / "web-teach.png"
+    if not args.no_page:
+        from bullet_world.viewer.snapshot import find_chromium
+
+        if find_chromium() is None:
+            print("no Chromium (apt-get install -y chromium): the page's picture is left as it is", file=sys.stderr)
+        else:
+            for name in available("kitchens"):
+                path = args.out / f"{name}-3d.png"
+                subprocess.run([str(Path(sys.executable).with_name("teachbot")), "view", "--kitchen", name, "--seed",
+                                str(args.seed), "--screenshot", str(path)], check=True, stdout=subprocess.DEVNULL)
+                picture = cv2.imread(str(path))
+                write_png(path, cv2.resize(picture, None, fx=0.75, fy=0.75, interpolation=cv2.INTER_AREA))
+                written.append({"kitchen": name, "picture": "3d", "path": str(path.relative_to(ROOT)),
+                                "bytes": path.stat().st_size})
+            subprocess.run([sys.executable, str(ROOT / "scripts" / "web_screenshot.py"), str(page)], check=True)
+            written.append({"kitchen": None, "picture": "page", "path": str(page.relative_to(ROOT)),
+                            "bytes": page.stat().st_size})
     for entry in written:
         print(f"{entry['path']}: {entry['bytes'] / 1024:.0f} KB")
     if args.json:
