@@ -1,7 +1,7 @@
 // Diffuse lighting for a 3D view that the CPU draws (SwiftShader, llvmpipe: a browser without a GPU).
 // meshcat gives every mesh a Phong material, lit per pixel by its five lights; once the kitchen's room fills
 // the view, that lighting is most of a software frame. A Lambert material with the same colour, texture and
-// transparency draws the same scene about five times cheaper (scripts/bench_viewer_frame.py), without the
+// transparency draws the same scene about four times cheaper (scripts/bench_viewer_frame.py), without the
 // specular highlights. Used by the page (app.js) and by the benchmark, so both measure the same thing.
 const diffuseOf = new WeakMap();  // Phong material -> its Lambert twin, made once
 
