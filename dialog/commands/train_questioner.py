@@ -48,6 +48,9 @@ def register(commands) -> None:
                            help="train across allocations: each episode draws its budget, turns and scene changes "
                                 "from FILE's ranges and the policy sees them (default file: "
                                 "dialog/data/rl-allocations.toml); not with --budget, --turns, --change-every")
+    condition.add_argument("--objects", type=positive_int, default=None, metavar="N",
+                           help="objects in a scene (default: the task's own size, 12; the thesis's pack-lunchbox "
+                                "experiments use 55)")
     condition.add_argument("--data-seed", type=seed, default=None,
                            help="the data sets' seed (default 100, which no chapter-6/7 report uses)")
     condition.add_argument("--price", type=price, default=0.0,
@@ -71,7 +74,8 @@ def run(args: argparse.Namespace) -> int:
     require_rl()
     env = {"task": args.task, "kitchen": args.kitchen, "budget": args.budget, "turns": args.turns,
            "change_every": args.change_every, "data_seed": args.data_seed,
-           "whatif": not args.no_whatif, "price": args.price, "allocations": allocations_of(args)}
+           "whatif": not args.no_whatif, "price": args.price, "allocations": allocations_of(args),
+           "objects_per_scene": args.objects}
     config = TrainingConfig(steps=args.steps, envs=args.envs or default_envs(), seed=args.seed,
                             env={k: v for k, v in env.items() if v is not None})
     print(f"training a questioner with masked PPO for {config.steps} steps on {config.envs} environment(s), "

@@ -14,7 +14,8 @@ answers, the learner's models are refit and scored on the held-out test pool.
 
 * Actions: ``Discrete(n)`` over the fixed slots of learning/rl/observation.py
   (no query, the feature query, a demonstration per concept, a label query per
-  scene object up to the task's largest scene). ``info["action_mask"]`` and
+  scene object, ``objects_per_scene`` of them: the task's own scene size unless given, e.g. 55 for
+  pack-lunchbox as in the thesis's experiments). ``info["action_mask"]`` and
   ``action_masks()`` say which slots are candidates this turn (affordable, and
   present in the scene); a masked slot is played as no query and flagged
   ``info["invalid_action"]``.
@@ -44,6 +45,7 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
+from bullet_world.catalogue import load_task
 from dialog.episode import build_episode
 from dialog.experiments.episodes import suite_teacher
 from dialog.experiments.irl_rollouts import training_condition
@@ -94,13 +96,14 @@ class QuestioningSettings:
     teacher: dict | None = None  # kind ("scripted" | "oracle"), mislabel_rate, dont_know_rate, feature_quality
     data_seed: int | None = None
     datasets: int | None = None
+    objects_per_scene: int | None = None  # None: the task's interactive size (pack-lunchbox's experiments: 55)
 
     def resolved(self) -> QuestioningSettings:
         """Every field filled in: the given ones, the rest from the training condition."""
         base = training_condition()
         filled = QuestioningSettings(base.task, base.kitchen, base.condition.budget, base.condition.turns,
                                      base.condition.change_every, dict(base.costs), dict(base.teacher),
-                                     base.data_seed, base.datasets)
+                                     base.data_seed, base.datasets, None)
         given = {name: value for name, value in self.__dict__.items() if value is not None}
         settings = replace(filled, **given)
         check_costs(settings.costs)
@@ -112,6 +115,12 @@ class QuestioningSettings:
             if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < low:
                 raise SettingsError(f"{name} must be a whole number of {low} or more, got {value!r}")
         check_limit("datasets", settings.datasets)
+        size = settings.objects_per_scene
+        if size is not None:
+            largest = load_task(settings.task).max_objects_per_scene
+            if isinstance(size, bool) or not isinstance(size, int | np.integer) or not 1 <= size <= largest:
+                raise SettingsError(f"objects_per_scene must be None or a whole number from 1 to {largest} (the "
+                                    f"largest scene of task '{settings.task}'), got {size!r}")
         EpisodeSettings(task=settings.task, kitchen=settings.kitchen, turns=settings.turns, budget=settings.budget,
                         change_every=settings.change_every, costs=dict(settings.costs))  # validates the allocation
         return settings
@@ -126,9 +135,9 @@ class QuestioningEnv(gym.Env):
                  turns: int | None = None, change_every: int | None = None, costs: dict | None = None,
                  teacher: dict | None = None, data_seed: int | None = None, datasets: int | None = None,
                  whatif: bool = True, price: float = 0.0, transcript: str | None = None,
-                 render_mode: str | None = None, allocations=None):
+                 render_mode: str | None = None, allocations=None, objects_per_scene: int | None = None):
         self.settings = QuestioningSettings(task, kitchen, budget, turns, change_every, costs, teacher, data_seed,
-                                            datasets).resolved()
+                                            datasets, objects_per_scene).resolved()
         self.allocations = None if allocations is None else ranges_from(allocations)
         given = [name for name, value in (("budget", budget), ("turns", turns), ("change_every", change_every))
                  if value is not None]
@@ -146,8 +155,11 @@ class QuestioningEnv(gym.Env):
             raise SettingsError(f"render_mode must be None or one of {self.metadata['render_modes']}, "
                                 f"got {render_mode!r}")
         s = self.settings
-        self.pools = load_pools(s.task, s.kitchen, s.datasets, data_seed=s.data_seed)
-        self.layout = ObservationLayout(tuple(self.pools.task.concepts), self.pools.task.objects_per_scene,
+        plan = () if s.objects_per_scene is None else (("objects_per_scene", int(s.objects_per_scene)),)
+        self.pools = load_pools(s.task, s.kitchen, s.datasets, plan_options=plan, data_seed=s.data_seed)
+        self.objects_per_scene = (self.pools.task.objects_per_scene if s.objects_per_scene is None
+                                  else int(s.objects_per_scene))
+        self.layout = ObservationLayout(tuple(self.pools.task.concepts), self.objects_per_scene,
                                         bool(whatif), allocation=self.allocations is not None)
         self.price, self.transcript_path, self.render_mode = float(price), transcript, render_mode
         self.engine = make_engine("fast")
@@ -178,7 +190,8 @@ class QuestioningEnv(gym.Env):
         a = self.allocation
         scenes = -(-a.turns // a.change_every)
         dataset = self.episode_seed % s.datasets if dataset is None else dataset
-        world = PoolEnvironment(self.pools.train[dataset], self.pools.test, self.pools.task, scenes)
+        world = PoolEnvironment(self.pools.train[dataset], self.pools.test, self.pools.task, scenes,
+                                self.objects_per_scene)
         rngs = episode_generators(self.episode_seed)
         settings = EpisodeSettings(task=s.task, kitchen=s.kitchen, strategy=AgentChooses.name, seed=self.episode_seed,
                                    turns=a.turns, budget=s.budget if self.allocations is None else a.budget,

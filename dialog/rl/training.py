@@ -190,7 +190,8 @@ def train(config: TrainingConfig, progress: bool = True, provenance: dict | None
                "final_accuracy_last_50": round(float(np.mean(recent)), 4) if recent else None,
                "final_accuracy_episodes": len(recent)}
     record = {**(provenance or {}), **{f"ppo_{k}": v for k, v in asdict(config).items() if k != "env"},
-              **{f"env_{k}": _plain(v) for k, v in probe.settings.__dict__.items()},
+              **{f"env_{k}": _plain(v) for k, v in probe.settings.__dict__.items() if v is not None},
+              "env_objects_per_scene": probe.objects_per_scene,
               **(probe.allocations.record() if probe.allocations is not None else {}),
               "algorithm": "MaskablePPO (sb3-contrib)", "hidden_layers": list(HIDDEN), **summary}
     return actor_policy(model, layout, record), summary

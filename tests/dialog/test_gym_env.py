@@ -139,6 +139,9 @@ def test_an_action_outside_the_action_space_raises_as_gymnasium_envs_do(action):
     ({"teacher": {"mislabel_rate": 2}}, "'mislabel_rate' must be >= 0 and <= 1"),
     ({"turns": 10**8}, "turns: 100000000 is beyond the limit of 10000"),
     ({"transcript": 3}, "transcript must be None or a path"),
+    ({"objects_per_scene": 0}, r"objects_per_scene must be None or a whole number from 1 to \d+ .*got 0"),
+    ({"objects_per_scene": 10**6}, r"objects_per_scene must be .*\(the largest scene of task 'prepare-lunch'\)"),
+    ({"objects_per_scene": 6.0}, "objects_per_scene must be None or a whole number"),
 ])
 def test_bad_settings_are_refused_with_what_is_wrong(kwargs, message):
     from learning.errors import TeachbotError
@@ -161,3 +164,22 @@ def test_reset_options_are_validated_not_ignored(options, message):
     assert env.records[0]["session"]["dataset"] == 3  # not 7 mod 5
     env.reset(seed=7, options={})
     assert env.records[0]["session"]["dataset"] == 2
+
+
+def test_objects_per_scene_sizes_the_scenes_the_label_slots_and_the_data_plan(monkeypatch):
+    import dialog.rl.gym_env as gym_env
+
+    asked = []
+    real = gym_env.load_pools
+
+    def recording(*args, plan_options=(), **kwargs):  # the task's own data, so nothing new is rendered
+        asked.append(plan_options)
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(gym_env, "load_pools", recording)
+    env = QuestioningEnv(**SMALL, objects_per_scene=6)
+    assert asked == [(("objects_per_scene", 6),)]  # the data set is the one a suite with 6 objects renders
+    assert env.layout.n_actions == 2 + 4 + 6 and env.objects_per_scene == 6
+    _, info = env.reset(seed=0)
+    assert env.manager.scene.n_objects == 6
+    assert info["action_mask"].shape == (env.layout.n_actions,)

@@ -50,6 +50,7 @@ def test_a_tiny_training_run_saves_a_policy_that_reloads(trained, capsys):
     provenance = policy.provenance
     assert provenance["algorithm"].startswith("MaskablePPO") and provenance["steps"] >= 256
     assert provenance["env_data_seed"] == 100 and provenance["env_turns"] == 8 and len(provenance["commit"]) >= 7
+    assert provenance["env_objects_per_scene"] == 12  # the task's own size when --objects is not given
     assert trained.with_suffix(".npz").is_file()
 
 
