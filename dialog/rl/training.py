@@ -142,16 +142,15 @@ def train(config: TrainingConfig, progress: bool = True, provenance: dict | None
     probe = make_env(config.env)()  # validates the options here, once, and renders the data sets if needed
     layout = probe.layout
     loading = time.perf_counter() - started  # the training environments load the same data sets again
-    per_turn = seconds_per_turn(probe, config.seed,
-                                episodes=ESTIMATE_EPISODES if probe.allocations is None else ESTIMATE_EPISODES_ACROSS)
+    probe_episodes = ESTIMATE_EPISODES if probe.allocations is None else ESTIMATE_EPISODES_ACROSS
+    per_turn = seconds_per_turn(probe, config.seed, episodes=probe_episodes)
     probe.close()
     so_far = time.perf_counter() - started
     estimate = so_far + loading + per_turn * config.steps / min(config.envs, os.cpu_count() or 1)
     say(f"this will take about {_duration(estimate)} in all: {so_far:.0f} s so far, {loading:.0f} s to start the "
         "environments, then "
         f"{config.steps} steps at {per_turn * 1000:.0f} ms per turn over {config.envs} environment(s) (timed on "
-        f"{ESTIMATE_EPISODES if probe.allocations is None else ESTIMATE_EPISODES_ACROSS}+ whole episodes of random "
-        "questions)")
+        f"{probe_episodes}+ whole episodes of random questions)")
     say(f"starting {config.envs} environment{'s' if config.envs > 1 else ''}"
         f"{' in worker processes' if config.envs > 1 else ''}, then training...")
     vec_cls = SubprocVecEnv if config.envs > 1 else DummyVecEnv
