@@ -39,8 +39,10 @@ def add_viewer_option(parser: argparse.ArgumentParser) -> None:
                             "run in a terminal, not at all otherwise; 0: close at once)")
 
 
-def start_viewer(args: argparse.Namespace, world):
-    """The viewer the options ask for, or None (nothing asked, or it could not start: one warning line)."""
+def start_viewer(args: argparse.Namespace, world, **options):
+    """The viewer the options ask for, or None (nothing asked, or it could not start: one warning line).
+    ``options`` go to the :class:`~bullet_world.viewer.mirror.Viewer` (``live_fps``: how often it mirrors a
+    moving arm)."""
     live = bool(getattr(args, "viewer", False))
     export = checked_export(getattr(args, "viewer_export", None))
     if not live and export is None:
@@ -48,7 +50,7 @@ def start_viewer(args: argparse.Namespace, world):
     try:
         from bullet_world.viewer.mirror import Viewer
 
-        viewer = Viewer(world, live=live, export_path=export)
+        viewer = Viewer(world, live=live, export_path=export, **options)
     except Exception as error:  # any failure to start leaves the session headless
         print(f"warning: the viewer did not start ({type(error).__name__}: {error}); going on without it",
               file=sys.stderr)

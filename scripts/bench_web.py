@@ -3,13 +3,18 @@
     python scripts/bench_web.py                   # 20 turns of dt-task, seed 0
     python scripts/bench_web.py --turns 30 --json # JSON last line
     python scripts/bench_web.py --no-3d           # the page without its 3D view
+    python scripts/bench_web.py --click-at-once   # click before the 3D view has drawn the question
 
 A real ``teachbot teach --web`` session is answered in headless Chromium by
 clicks (a concept button, an object's number button, the feature checkboxes);
 for every answer the time from the click to the next question being shown and
-waiting in the page is measured (and, of it, the time until the question's
-message reached the browser), and the page's load time (from opening the URL
-to the first question ready to answer and, with the 3D view, drawn in it).
+waiting in the page is measured (shown: its words and buttons painted), and, of
+it, the time until the question's message reached the browser; with the 3D
+view, also the time until the view has drawn it. The next click comes once the
+view has drawn the question, as a participant reads before answering
+(``--click-at-once``: as soon as it is shown, so that the click waits behind
+the view's frame). The page's load time runs from opening the URL to the
+first question ready to answer and, with the 3D view, drawn in it.
 Then the same answers are typed into ``teachbot teach`` at a pseudo-terminal,
 and the time from Enter to the next prompt is measured the same way. Both include the robot's own
 work between the questions (the strategy's decision, the arm's pointing);
@@ -46,6 +51,11 @@ READY = """() => {
     return Boolean(question && waiting && (!viewer || (drawn3d === question.id && !viewer.needs_render
         && Object.keys(objectNodes).length > 0 && [...Object.keys(objectNodes), "robot"].every(drawn))));
 }"""
+# The next question (not the one answered, ``id``) is on the screen: it waits for its answer and its words and
+# buttons have been painted (app.js's ``painted``), or the session ended.
+SHOWN = "(id) => ended || (question && waiting && question.id !== id && painted === question.id)"
+# ... and the 3D view has drawn it too (nothing waits to be drawn).
+DRAWN = "() => ended || !viewer || (drawn3d === question.id && !viewer.needs_render)"
 
 
 def processes(roots: list[int]) -> dict[int, str]:
@@ -93,6 +103,18 @@ def cpu_by_part(named: dict[int, str], before: dict[int, float], after: dict[int
     return {part: round(seconds, 2) for part, seconds in parts.items()}
 
 
+def page_clock(page) -> float:
+    """This process's ``time.perf_counter()`` at the page's ``performance.now()`` of 0, in seconds: from the
+    quickest of a few round trips, to a millisecond or so, while the page is idle."""
+    trips = []
+    for _ in range(7):
+        before = time.perf_counter()
+        now_ms = page.evaluate("() => performance.now()")
+        after = time.perf_counter()
+        trips.append((after - before, (before + after) / 2 - now_ms / 1000))
+    return min(trips)[1]
+
+
 def web_session(args, folder: Path) -> dict:
     """Answer a --web session by clicks; the click-to-question times, the page's load time, and over the
     answered turns the CPU seconds of each part, the 3D frames drawn and the wall seconds."""
@@ -110,7 +132,7 @@ def web_session(args, folder: Path) -> dict:
     threading.Thread(target=lambda: [None for _ in process.stdout], daemon=True).start()
     if url is None:
         raise SystemExit("teachbot teach --web printed no URL")
-    times, arrivals, received = [], [], {}
+    times, arrivals, drawn, received = [], [], [], {}
 
     def watch(socket) -> None:  # when each "waiting" message reaches the browser (its network layer)
         def frame(payload) -> None:
@@ -132,6 +154,7 @@ def web_session(args, folder: Path) -> dict:
             named = processes([process.pid, os.getpid()])
             named.pop(os.getpid(), None)  # this script's own driving is neither the session nor the page
             frames = "() => viewer ? viewer.renderer.info.render.frame : 0"
+            clock = page_clock(page)  # the page says when it painted a question, in its own clock
             cpu_before, frames_before, turns_started = cpu_seconds(named), page.evaluate(frames), time.perf_counter()
             while True:
                 question = page.evaluate("() => question")
@@ -144,21 +167,24 @@ def web_session(args, folder: Path) -> dict:
                     page.locator("#features input[data-number='1.1']").check()
                     clicked = time.perf_counter()
                     page.get_by_role("button", name="use these").click()
-                page.wait_for_function("(id) => ended || (question && waiting && question.id !== id)",
-                                       arg=question["id"], timeout=120_000, polling=5)
-                shown = time.perf_counter()
+                page.wait_for_function(SHOWN, arg=question["id"], timeout=120_000, polling=5)
+                shown = clock + page.evaluate("() => paintedAt") / 1000  # not when this poll noticed it
                 if page.evaluate("() => ended"):
                     cpu = cpu_by_part(named, cpu_before, cpu_seconds(named))
                     frames_3d, wall_s = page.evaluate(frames) - frames_before, time.perf_counter() - turns_started
                     break
                 times.append((shown - clicked) * 1000)
                 arrivals.append((received.get(page.evaluate("() => question.id"), shown) - clicked) * 1000)
+                if not args.click_at_once:  # a participant reads the question (and looks at the view) first
+                    page.wait_for_function(DRAWN, timeout=120_000, polling=5)
+                    drawn.append((time.perf_counter() - clicked) * 1000)
             browser.close()
         process.wait(60)
     finally:
         if process.poll() is None:
             process.kill()
-    return {"click_to_question_ms": times, "click_to_arrival_ms": arrivals, "page_load_ms": load_ms,
+    return {"click_to_question_ms": times, "click_to_arrival_ms": arrivals, "click_to_drawn_ms": drawn,
+            "page_load_ms": load_ms,
             "cpu_seconds": cpu, "frames_3d": frames_3d, "wall_s": round(wall_s, 1)}
 
 
@@ -196,6 +222,8 @@ def main(argv=None) -> int:
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--strategy", default="dt-task")
     parser.add_argument("--no-3d", action="store_true", help="the page without its 3D view (camera picture only)")
+    parser.add_argument("--click-at-once", action="store_true",
+                        help="click as soon as the question is shown, without waiting for the 3D view to draw it")
     parser.add_argument("--json", action="store_true", help="end with one JSON line")
     args = parser.parse_args(argv)
     if find_chromium() is None:
@@ -210,10 +238,12 @@ def main(argv=None) -> int:
     same = [r["action"] for r in records] == [r["action"] for r in typed]
     page, at_terminal = summary(web["click_to_question_ms"]), summary(terminal)
     arrival = summary(web["click_to_arrival_ms"])
+    drawn = summary(web["click_to_drawn_ms"]) if web["click_to_drawn_ms"] else None
     overhead = round(page["p95"] - at_terminal["p95"], 1)
     result = {"turns": args.turns, "seed": args.seed, "strategy": args.strategy, "3d_view": not args.no_3d,
-              "same_questions": same,
+              "click_at_once": args.click_at_once, "same_questions": same,
               "page_click_to_question_ms": page, "page_click_to_arrival_ms": arrival,
+              "page_click_to_3d_drawn_ms": drawn,
               "terminal_enter_to_question_ms": at_terminal,
               "page_load_ms": round(web["page_load_ms"], 1), "page_p95_overhead_ms": overhead,
               "goal_ms": GOAL_MS, "goal_met": page["p95"] < at_terminal["p95"] + GOAL_MS,
@@ -225,6 +255,9 @@ def main(argv=None) -> int:
           f"max {page['max']:.0f} ms  (n={page['n']})")
     print(f"          of which until the question reached the browser  p50 {arrival['p50']:.0f} ms  "
           f"p95 {arrival['p95']:.0f} ms (the rest: the page showing it)")
+    if drawn is not None and not args.no_3d:
+        print(f"          click until the 3D view has drawn it too  p50 {drawn['p50']:.0f} ms  "
+              f"p95 {drawn['p95']:.0f} ms (then the next click)")
     print(f"terminal: Enter to next question  p50 {at_terminal['p50']:.0f} ms  p95 {at_terminal['p95']:.0f} ms  "
           f"max {at_terminal['max']:.0f} ms  (n={at_terminal['n']})")
     drawn = "" if args.no_3d else ", drawn in the 3D view"

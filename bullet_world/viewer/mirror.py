@@ -113,7 +113,7 @@ class Viewer:
 
     def __init__(self, world, *, live: bool = True, record: bool = False, export_path: str | Path | None = None,
                  camera: tuple | None = None, appearance=None, fps: int = 20, live_fps: float = 30.0,
-                 start_timeout_s: float = 20.0, reply_timeout_s: float = 10.0):
+                 panels: bool = True, start_timeout_s: float = 20.0, reply_timeout_s: float = 10.0):
         if fps < 1 or live_fps <= 0:
             raise SettingsError(f"the viewer needs fps >= 1 and live_fps > 0, got fps={fps}, live_fps={live_fps}")
         self.world, self.client = world, world.client
@@ -124,6 +124,7 @@ class Viewer:
         self.recording_started = False
         self.episode_time = 0.0
         self.question = self.answer = ""
+        self.panels = panels  # the question and the answer as text in the scene (a page shows them beside it)
         self.asked: int | None = None
         self.shown: int | None = None
         self._asked_this_turn = False
@@ -247,7 +248,7 @@ class Viewer:
                 size = tuple(round(float(v), 3) for v in (high - low) + 0.03)
                 nodes[f"overlay/{name}"] = ((Look("box", size, rgba),), translation(*((low + high) / 2)))
         top = self._text_anchor.copy()
-        for name, text in (("question", self.question), ("answer", self.answer)):
+        for name, text in (("question", self.question), ("answer", self.answer)) if self.panels else ():
             if text:  # sprites face the camera, so they stack along the camera's up direction
                 text = _wrapped(text)
                 height = TEXT_HEIGHT_M * (text.count("\n") + 1)

@@ -68,6 +68,10 @@ def web_continue_options(args: argparse.Namespace) -> tuple:
 
 WAIT_FOR_PAGE_S = 60.0
 MIRROR_WAIT_S = 2.0  # the longest a question waits for the 3D view's mirror (a stuck meshcat server stops it)
+# While the robot works the page draws its 3D view at most 3 times a second (app.js, BUSY_3D_FPS), so the
+# mirror sends the moving arm to it at twice that, not at the stand-alone viewer's 30: each frame sent costs the
+# session, meshcat's server and the page's main thread their share of the 2 cores the robot needs.
+PAGE_MIRROR_FPS = 6.0
 
 
 class Watcher:
@@ -142,7 +146,8 @@ class WebPage:
             from dialog.viewer import start_viewer
 
             export = getattr(self.args, "viewer_export", None)
-            self.viewer = start_viewer(argparse.Namespace(viewer=True, viewer_export=export), environment.world)
+            self.viewer = start_viewer(argparse.Namespace(viewer=True, viewer_export=export), environment.world,
+                                       live_fps=PAGE_MIRROR_FPS, panels=False)  # the page has the words
         self.server.meshcat_socket_url = meshcat_socket(getattr(self.viewer, "url", None))
         self.teacher.new_view(self.viewer is not None)
 

@@ -6,6 +6,7 @@ import base64
 import re
 import socket
 import threading
+import time
 from pathlib import Path
 from types import SimpleNamespace
 
@@ -370,6 +371,32 @@ def test_observer_highlights_the_asked_object_and_shows_the_dialog(bare):
         assert viewer.frame()["overlay/question"][0][0].text == "Robot stays quiet."
         viewer.on_scene(None)
         assert not any(node.startswith("overlay/") for node in viewer.frame())
+    finally:
+        viewer.close()
+
+
+def test_a_viewer_without_panels_highlights_but_leaves_the_words_to_the_page(bare):
+    bare.three_objects()
+    viewer = Viewer(bare, live=False, panels=False)
+    try:
+        viewer.on_scene(None)
+        viewer.on_question(SimpleNamespace(kind="label", object_index=1, concept=None), "What is this (object 2)?")
+        viewer.on_answer(SimpleNamespace(kind="label"), SimpleNamespace(raw="a fruit", kind="answer", value="fruit"))
+        frame = viewer.frame()
+        assert "overlay/asked" in frame and "labels/" in " ".join(frame)
+        assert "overlay/question" not in frame and "overlay/answer" not in frame
+    finally:
+        viewer.close()
+
+
+def test_live_fps_bounds_the_frames_a_moving_arm_sends(bare):
+    viewer = Viewer(bare, live_fps=5.0)
+    try:
+        published = viewer.thread.frames_published
+        started = time.perf_counter()
+        while time.perf_counter() - started < 1.0:  # a second of stepping as fast as the machine goes
+            p.stepSimulation(physicsClientId=bare.client)
+        assert 3 <= viewer.thread.frames_published - published <= 6  # at most 5 a second, not one a step
     finally:
         viewer.close()
 

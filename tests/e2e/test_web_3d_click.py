@@ -57,6 +57,14 @@ def test_a_click_on_the_object_in_the_3d_view_shows_it(tmp_path):
             page.on("pageerror", lambda error: errors.append(str(error)))
             question = wait_for_question(page)
             assert question["expects"] == "feature"  # all-cd asks which features matter first
+            # every frame's start; and the next question comes with something new to draw, as the arm's pose does
+            page.evaluate("""() => { window.drawnAt = []; const draw = viewer.renderer.render.bind(viewer.renderer);
+                viewer.renderer.render = (scene, camera) => { drawnAt.push(performance.now()); draw(scene, camera); };
+                const handled = window.handle;
+                window.handle = (message) => {
+                    handled(message);
+                    if (message.type === "waiting") { viewer.needs_render = true; }
+                }; }""")
             page.locator("#features input[data-number='1.1']").check()
             page.get_by_role("button", name="use these").click()
             question = wait_for_question(page, after=question["id"])
@@ -64,6 +72,11 @@ def test_a_click_on_the_object_in_the_3d_view_shows_it(tmp_path):
             concept = question["text"].split("show me ")[1].split("?")[0].split(" ", 1)[1]
             page.wait_for_function("() => Object.keys(objectNodes).length > 0")
             time.sleep(1.0)  # the 3D view has drawn the scene
+            # a frame drawn in software holds the page, so the question is painted first and the view drawn after
+            arrived, painted, drawn = page.evaluate("[shownAt, painted === question.id ? paintedAt : null, drawnAt]")
+            assert painted is not None and painted >= arrived
+            assert not [t for t in drawn if arrived <= t < painted], (arrived, painted, drawn)
+            assert [t for t in drawn if t >= painted], "the 3D view was not drawn after the question"
             # headless Chromium draws WebGL in software: the view is drawn with diffuse materials (diffuse.js)
             assert page.evaluate("software3d")
             materials = page.evaluate("""() => { const kinds = new Set();

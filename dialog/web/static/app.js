@@ -187,7 +187,9 @@ function sendFeatures(mode) {
 
 function setWaiting(on) {
   if (waiting && !on) { busySince = performance.now(); }
+  const asking = !waiting && Boolean(on) && !ended;
   waiting = Boolean(on) && !ended;
+  if (asking && question) { afterPaint(question.id); }
   document.querySelectorAll("#ask button, #ask input").forEach((element) => { element.disabled = !waiting; });
   if (waiting && question) { status(`Turn ${question.turn}: your answer, please`); }
   else if (!ended && !$("screen").hidden) { status($("screen").dataset.title); }  // a study screen says what it is
@@ -341,18 +343,36 @@ const SOFTWARE_BUSY_MS = 1000;  // without one: at most one frame a second, and 
 let software3d = false;    // whether the CPU draws the 3D view (softwareWebGL)
 let busySince = 0;         // when the robot began working (the answer was sent)
 let drawn3d = null;        // the last question the 3D view was drawn for while it waited (its id)
+let painted = null;        // the last question whose words and buttons are on the screen (its id)
+let paintedAt = 0;         // when that was (performance.now(); scripts/bench_web.py reads it)
+
+function afterPaint(id) {
+  // note when the question waiting for its answer has been painted: after the next frame's rendering (a
+  // callback before it, a task after it); the 3D view, drawn in software, waits for that (throttle3d)
+  requestAnimationFrame(() => setTimeout(() => {
+    painted = id;
+    paintedAt = performance.now();
+    if (viewer) { viewer.needs_render = true; }
+  }, 0));
+}
 
 function throttle3d() {
   // meshcat renders on the next animation frame after every change. While the robot is busy (pointing, deciding)
   // the page draws at most BUSY_3D_FPS frames a second. Drawn by the CPU (no GPU) a frame takes a core for a
   // tenth to a fifth of a second, which the robot needs between an answer and the next question: so there,
   // while the robot works for an answer, the view is drawn at most once a second and not in the first second
-  // (most turns end sooner). When the question arrives, the view is drawn at once (the arm pointing, the
-  // highlight), and freely while the question waits (orbiting the view).
+  // (most turns end sooner). When the question arrives, the view is drawn as soon as the question's words are
+  // on the screen (the arm pointing, the highlight): a frame drawn in software holds the page until it is done
+  // (Chromium reads it back for its software compositor), so drawn first it would hold the question back by as
+  // long. While the question waits the view is drawn freely (orbiting it).
   const render = viewer.render.bind(viewer);
   let last = 0;
   viewer.render = () => {
     const now = performance.now();
+    if (software3d && waiting && question && painted !== question.id) {
+      viewer.needs_render = true;
+      return;
+    }
     const held = software3d && !(question && question.watch)  // a watched demo has no answers to wait for
       ? now - Math.max(last, busySince) < SOFTWARE_BUSY_MS : now - last < 1000 / BUSY_3D_FPS;
     if (!waiting && !ended && held) {
