@@ -175,7 +175,7 @@ def web_session(args, folder: Path) -> dict:
                     break
                 times.append((shown - clicked) * 1000)
                 arrivals.append((received.get(page.evaluate("() => question.id"), shown) - clicked) * 1000)
-                if not args.click_at_once:  # a participant reads the question (and looks at the view) first
+                if not (args.click_at_once or args.no_3d):  # a participant reads the question (and looks at the view)
                     page.wait_for_function(DRAWN, timeout=120_000, polling=5)
                     drawn.append((time.perf_counter() - clicked) * 1000)
             browser.close()
@@ -255,7 +255,7 @@ def main(argv=None) -> int:
           f"max {page['max']:.0f} ms  (n={page['n']})")
     print(f"          of which until the question reached the browser  p50 {arrival['p50']:.0f} ms  "
           f"p95 {arrival['p95']:.0f} ms (the rest: the page showing it)")
-    if drawn is not None and not args.no_3d:
+    if drawn is not None:
         print(f"          click until the 3D view has drawn it too  p50 {drawn['p50']:.0f} ms  "
               f"p95 {drawn['p95']:.0f} ms (then the next click)")
     print(f"terminal: Enter to next question  p50 {at_terminal['p50']:.0f} ms  p95 {at_terminal['p95']:.0f} ms  "
