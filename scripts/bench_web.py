@@ -238,12 +238,12 @@ def main(argv=None) -> int:
     same = [r["action"] for r in records] == [r["action"] for r in typed]
     page, at_terminal = summary(web["click_to_question_ms"]), summary(terminal)
     arrival = summary(web["click_to_arrival_ms"])
-    drawn = summary(web["click_to_drawn_ms"]) if web["click_to_drawn_ms"] else None
+    drawn_3d = summary(web["click_to_drawn_ms"]) if web["click_to_drawn_ms"] else None
     overhead = round(page["p95"] - at_terminal["p95"], 1)
     result = {"turns": args.turns, "seed": args.seed, "strategy": args.strategy, "3d_view": not args.no_3d,
               "click_at_once": args.click_at_once, "same_questions": same,
               "page_click_to_question_ms": page, "page_click_to_arrival_ms": arrival,
-              "page_click_to_3d_drawn_ms": drawn,
+              "page_click_to_3d_drawn_ms": drawn_3d,
               "terminal_enter_to_question_ms": at_terminal,
               "page_load_ms": round(web["page_load_ms"], 1), "page_p95_overhead_ms": overhead,
               "goal_ms": GOAL_MS, "goal_met": page["p95"] < at_terminal["p95"] + GOAL_MS,
@@ -255,9 +255,9 @@ def main(argv=None) -> int:
           f"max {page['max']:.0f} ms  (n={page['n']})")
     print(f"          of which until the question reached the browser  p50 {arrival['p50']:.0f} ms  "
           f"p95 {arrival['p95']:.0f} ms (the rest: the page showing it)")
-    if drawn is not None:
-        print(f"          click until the 3D view has drawn it too  p50 {drawn['p50']:.0f} ms  "
-              f"p95 {drawn['p95']:.0f} ms (then the next click)")
+    if drawn_3d is not None:
+        print(f"          click until the 3D view has drawn it too  p50 {drawn_3d['p50']:.0f} ms  "
+              f"p95 {drawn_3d['p95']:.0f} ms (then the next click)")
     print(f"terminal: Enter to next question  p50 {at_terminal['p50']:.0f} ms  p95 {at_terminal['p95']:.0f} ms  "
           f"max {at_terminal['max']:.0f} ms  (n={at_terminal['n']})")
     drawn = "" if args.no_3d else ", drawn in the 3D view"
