@@ -6,7 +6,7 @@ VENV ?= .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.teachbot-installed
 
-.PHONY: demo test lint clean experiments
+.PHONY: demo test lint clean experiments readme-tables
 
 $(STAMP): pyproject.toml
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
@@ -31,3 +31,10 @@ clean:
 # docs/experiments.md and the README from that run, each stamped with the commit and command.
 experiments: $(STAMP)
 	$(PY) scripts/experiments.py
+
+# Only the README's demo and study tables (docs/readme-tables.toml; a few minutes): play their teachbot demo
+# and study commands, rewrite the summary:demo and summary:study blocks wherever README.md has their markers,
+# retake the study figure and record the checked transcripts' hashes that tests/dialog/test_readme_tables.py
+# replays (docs/readme-tables-record.json). The demo's options there are the ones `make demo` runs.
+readme-tables: $(STAMP)
+	$(PY) scripts/experiments.py --suites readme

@@ -3,6 +3,7 @@
     python scripts/experiments.py                  # run docs/experiments.toml, then rewrite the docs' tables
     python scripts/experiments.py --render         # rewrite the tables from the last run's files only
     python scripts/experiments.py --suites ch7 ... # only these runs (the others' tables are left alone)
+    python scripts/experiments.py --suites readme  # only the README's demo and study tables (make readme-tables)
 
 Each run is a ``teachbot regress`` command (episodes suites with ``--data-seeds``);
 results go to ``results/experiments/SUITE/``, and ``results/experiments/manifest.json``
@@ -10,6 +11,14 @@ records the commit, the commands, the machine's cores and every wall time. Every
 table is written between its markers with a stamp line naming that commit and
 command (``dialog/experiments/doc_tables.py``). A run refuses a tree with
 uncommitted changes to the code (``--allow-dirty`` runs anyway and the stamps say so).
+
+The plan's ``readme`` file (``docs/readme-tables.toml``) lists the README's two other measured tables: the
+demo's (options, strategies, seeds) and the simulated example study's (study file, participants). The run
+named ``readme`` plays those ``teachbot demo`` and ``teachbot study`` commands one after another into
+``results/experiments/readme/``, rewrites the blocks ``summary:demo`` and ``summary:study`` wherever the plan's
+docs have their markers (and copies the study's curves figure), and writes the SHA-256 of a cheap subset's
+transcripts to ``docs/readme-tables-record.json``; ``tests/dialog/test_readme_tables.py`` replays that subset
+and fails when the code no longer gives those bytes (``dialog/experiments/readme_tables.py``).
 """
 
 from __future__ import annotations
@@ -43,10 +52,13 @@ from dialog.experiments.doc_tables import (  # noqa: E402
     verdict_words,
 )
 from dialog.experiments.progress import SweepProgress, relay  # noqa: E402
+from dialog.experiments.readme_tables import NAME as README  # noqa: E402
+from dialog.experiments.readme_tables import RECORD_FILE as README_RECORD  # noqa: E402
+from dialog.experiments.readme_tables import load_spec, readme_tables, run_readme, write_check  # noqa: E402
 from dialog.experiments.record import RECORD_FILE, STATUS_DOCS, record_status, status_text, write_record, write_status  # noqa: E402
 from dialog.experiments.runner import episode_specs  # noqa: E402
 from dialog.experiments.suite import load_suite  # noqa: E402
-from learning.errors import SettingsError  # noqa: E402
+from learning.errors import SettingsError, TeachbotError  # noqa: E402
 
 CODE = ("learning", "dialog", "bullet_world", "robot", "pyproject.toml")
 DEFAULT_PLAN = ROOT / "docs" / "experiments.toml"
@@ -93,11 +105,17 @@ def run_one(words: list[str], line: SweepProgress | None) -> subprocess.Complete
     return subprocess.CompletedProcess(child.args, child.returncode, stdout)
 
 
-def run_all(plan: Plan, only: list[str] | None, out: Path, allow_dirty: bool, progress: bool = True) -> dict:
+def code_dirty(allow_dirty: bool) -> bool:
+    """Whether the code has uncommitted changes; refused unless ``allow_dirty`` (the stamps then say so)."""
     dirty = bool(git("status", "--porcelain", "--", *CODE))
     if dirty and not allow_dirty:
         raise SettingsError("the code has uncommitted changes (git status -- " + " ".join(CODE) + "): commit "
                             "first, so that the stamps name the code that made the tables, or give --allow-dirty")
+    return dirty
+
+
+def run_all(plan: Plan, only: list[str] | None, out: Path, allow_dirty: bool, progress: bool = True) -> dict:
+    dirty = code_dirty(allow_dirty)
     manifest_path = out / "manifest.json"
     manifest = json.loads(manifest_path.read_text()) if manifest_path.exists() and only else {"runs": {}}
     manifest.update({"commit": git("rev-parse", "HEAD"), "dirty": dirty, "cores": os.cpu_count(),
@@ -249,7 +267,11 @@ def wall_times(manifest: dict) -> str:
 
 def render(plan: Plan, manifest: dict, out: Path, command: str = "make experiments") -> list[str]:
     """Every table of the plan into its docs; ``command`` is what the summary tables' stamps name."""
-    tables = tables_from(plan, manifest, out, command)
+    return write_blocks(plan, tables_from(plan, manifest, out, command))
+
+
+def write_blocks(plan: Plan, tables: dict[str, str]) -> list[str]:
+    """Each table between its markers in every doc of the plan; "doc: block" for each one written."""
     written = []
     for doc in plan.docs:
         path = ROOT / doc
@@ -257,6 +279,26 @@ def render(plan: Plan, manifest: dict, out: Path, command: str = "make experimen
         path.write_text(text, encoding="utf-8")
         written += [f"{doc}: {name}" for name in replaced]
     return written
+
+
+def readme_run(plan: Plan, out: Path, render_only: bool, allow_dirty: bool, command: str) -> list[str]:
+    """The README's demo and study tables (``plan.readme``): play their commands (unless ``render_only``), record
+    the checked transcripts' hashes in docs/readme-tables-record.json, and write the blocks."""
+    spec = load_spec(ROOT / str(plan.readme))
+    if render_only:
+        path = out / "readme.json"
+        if not path.exists():
+            raise SettingsError(f"{path}: no run of the README tables to render from (run without --render first)")
+        readme = json.loads(path.read_text())
+        return write_blocks(plan, readme_tables(spec, readme, out))
+    meta = {"commit": git("rev-parse", "HEAD"), "dirty": code_dirty(allow_dirty), "date": datetime.date.today()
+            .isoformat(), "cores": os.cpu_count(), "command": command}
+    print(f"$ the README tables of {plan.readme} (results in {os.path.relpath(out, ROOT)})", flush=True)
+    began = time.perf_counter()
+    readme = run_readme(spec, out, meta, lambda line: print(line, flush=True))
+    print(f"  {README}: {time.perf_counter() - began:.0f} s", flush=True)
+    write_check(readme)
+    return [*write_blocks(plan, readme_tables(spec, readme, out)), str(README_RECORD.relative_to(ROOT))]
 
 
 def mark_record(manifest: dict) -> list[str]:
@@ -280,32 +322,48 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     try:
         plan = load_plan(args.plan)
-        unknown = sorted(set(args.suites or []) - {run.suite for run in plan.runs})
+        if plan.readme:
+            load_spec(ROOT / plan.readme)  # a bad file is one message now, not after an hour of suites
+        names = [run.suite for run in plan.runs] + ([README] if plan.readme else [])
+        unknown = sorted(set(args.suites or []) - set(names))
         if unknown:
-            raise SettingsError(f"--suites: {', '.join(unknown)} not in {args.plan} "
-                                f"({', '.join(r.suite for r in plan.runs)})")
-        if args.render:
-            manifest_path = args.results / "manifest.json"
-            if not manifest_path.exists():
-                raise SettingsError(f"{manifest_path}: no run to render from (run without --render first)")
-            manifest = json.loads(manifest_path.read_text())
-        else:
-            manifest = run_all(plan, args.suites, args.results, args.allow_dirty, not args.no_progress)
-        command = "make experiments" if args.plan.resolve() == DEFAULT_PLAN else \
-            f"python scripts/experiments.py --plan {os.path.relpath(args.plan.resolve(), ROOT)}"
-        for line in render(plan, manifest, args.results, command):
-            print(f"wrote {line}")
-        if not args.render and not args.suites and args.plan.resolve() == DEFAULT_PLAN and not manifest.get("dirty"):
+            raise SettingsError(f"--suites: {', '.join(unknown)} not in {args.plan} ({', '.join(names)})")
+        default = args.plan.resolve() == DEFAULT_PLAN
+        plan_words = "" if default else f" --plan {os.path.relpath(args.plan.resolve(), ROOT)}"
+        command = "make experiments" if default else f"python scripts/experiments.py{plan_words}"
+        only = None if args.suites is None else [name for name in args.suites if name != README]
+        manifest = None
+        if only is None or only:
+            manifest = suites_run(plan, args, only)
+            for line in render(plan, manifest, args.results, command):
+                print(f"wrote {line}")
+        if plan.readme and (args.suites is None or README in args.suites):
+            readme_command = command if args.suites is None else f"python scripts/experiments.py{plan_words} " \
+                                                                  f"--suites {README}"
+            for line in readme_run(plan, args.results / README, args.render, args.allow_dirty, readme_command):
+                print(f"wrote {line}")
+        if manifest and not args.render and not args.suites and default and not manifest.get("dirty"):
             for line in mark_record(manifest):
                 print(f"wrote {line}")
-    except SettingsError as error:
+    except TeachbotError as error:
         print(f"experiments: {error}", file=sys.stderr)
         return 2
-    print(f"experiments: {len(manifest['runs'])} runs, {manifest.get('wall_seconds', 0):.0f} s, commit "
-          f"{manifest['commit'][:10]}")
-    if args.json:
-        print(json.dumps(manifest))
+    if manifest is not None:
+        print(f"experiments: {len(manifest['runs'])} runs, {manifest.get('wall_seconds', 0):.0f} s, commit "
+              f"{manifest['commit'][:10]}")
+        if args.json:
+            print(json.dumps(manifest))
     return 0
+
+
+def suites_run(plan: Plan, args: argparse.Namespace, only: list[str] | None) -> dict:
+    """The manifest of the suites' run: the last one's (``--render``), or a new run of ``only`` (None: all)."""
+    if not args.render:
+        return run_all(plan, only, args.results, args.allow_dirty, not args.no_progress)
+    manifest_path = args.results / "manifest.json"
+    if not manifest_path.exists():
+        raise SettingsError(f"{manifest_path}: no run to render from (run without --render first)")
+    return json.loads(manifest_path.read_text())
 
 
 if __name__ == "__main__":

@@ -30,6 +30,7 @@ BEGIN_LINE = "<!-- experiments:begin {name} -->"
 END = "<!-- experiments:end {name} -->"
 STAMP_PREFIX = "<sub>Made by `make experiments`"
 SUMMARIES = ("summary:findings", "summary:demo-share", "summary:wall-times", "summary:suites")
+README_BLOCKS = ("summary:demo", "summary:study")  # the plan's `readme` run (dialog/experiments/readme_tables.py)
 PARTS = ("results", "findings", "report")  # SUITE:PART blocks: episodes suites write the first two, others "report"
 
 
@@ -51,6 +52,7 @@ class Plan:
     seeds: tuple[int, ...]
     runs: tuple[Run, ...]
     thesis_demo_share: dict[str, float] = field(default_factory=dict)
+    readme: str | None = None  # the README's demo and study tables: their file (docs/readme-tables.toml)
 
 
 def load_plan(path: Path) -> Plan:
@@ -59,10 +61,13 @@ def load_plan(path: Path) -> Plan:
         data = tomllib.loads(path.read_text(encoding="utf-8"))
     except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as error:
         raise SettingsError(f"{path}: cannot read the experiments plan ({error})") from None
-    unknown = set(data) - {"docs", "data_seeds", "seeds", "run", "thesis_demo_share"}
+    unknown = set(data) - {"docs", "data_seeds", "seeds", "run", "thesis_demo_share", "readme"}
     if unknown:
         raise SettingsError(f"{path}: unknown keys {', '.join(sorted(unknown))} (expected docs, data_seeds, seeds, "
-                            "run, thesis_demo_share)")
+                            "run, thesis_demo_share, readme)")
+    readme = data.get("readme")
+    if readme is not None and not isinstance(readme, str):
+        raise SettingsError(f"{path}: readme must be the path of the README tables' file, got {readme!r}")
     runs = []
     for index, entry in enumerate(data.get("run", []), 1):
         if not isinstance(entry, dict) or not isinstance(entry.get("suite"), str):
@@ -80,7 +85,7 @@ def load_plan(path: Path) -> Plan:
     if not runs:
         raise SettingsError(f"{path}: no [[run]] entries")
     return Plan(tuple(data.get("docs", [])), tuple(data.get("data_seeds", [0])), tuple(data.get("seeds", [0])),
-                tuple(runs), {str(k): float(v) for k, v in data.get("thesis_demo_share", {}).items()})
+                tuple(runs), {str(k): float(v) for k, v in data.get("thesis_demo_share", {}).items()}, readme)
 
 
 def stamp(manifest: dict, command: str) -> str:

@@ -10,7 +10,16 @@ from pathlib import Path
 
 import pytest
 
-from dialog.experiments.doc_tables import PARTS, STAMP_PREFIX, SUMMARIES, blocks_in, load_plan, splice, unstamped_tables
+from dialog.experiments.doc_tables import (
+    PARTS,
+    README_BLOCKS,
+    STAMP_PREFIX,
+    SUMMARIES,
+    blocks_in,
+    load_plan,
+    splice,
+    unstamped_tables,
+)
 from learning.errors import SettingsError
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -33,7 +42,7 @@ def test_the_readme_suite_table_is_generated_and_stamped():
 
 def test_every_block_the_docs_name_is_one_the_plan_can_write():
     plan = load_plan(ROOT / "docs" / "experiments.toml")
-    writable = set(SUMMARIES)
+    writable = set(SUMMARIES) | (set(README_BLOCKS) if plan.readme else set())
     writable |= {f"{run.suite}:{part}" for run in plan.runs for part in PARTS}
     for doc in plan.docs:
         names = blocks_in((ROOT / doc).read_text(encoding="utf-8"))
