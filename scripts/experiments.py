@@ -39,6 +39,8 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from dialog.experiments.doc_tables import (  # noqa: E402
+    BEGIN_LINE,
+    README_BLOCKS,
     Plan,
     finding_verdict,
     findings_table,
@@ -289,8 +291,7 @@ def readme_run(plan: Plan, out: Path, render_only: bool, allow_dirty: bool, comm
         path = out / "readme.json"
         if not path.exists():
             raise SettingsError(f"{path}: no run of the README tables to render from (run without --render first)")
-        readme = json.loads(path.read_text())
-        return write_blocks(plan, readme_tables(spec, readme, out))
+        return readme_blocks(plan, spec, json.loads(path.read_text()), out)
     meta = {"commit": git("rev-parse", "HEAD"), "dirty": code_dirty(allow_dirty), "date": datetime.date.today()
             .isoformat(), "cores": os.cpu_count(), "command": command}
     print(f"$ the README tables of {plan.readme} (results in {os.path.relpath(out, ROOT)})", flush=True)
@@ -298,7 +299,18 @@ def readme_run(plan: Plan, out: Path, render_only: bool, allow_dirty: bool, comm
     readme = run_readme(spec, out, meta, lambda line: print(line, flush=True))
     print(f"  {README}: {time.perf_counter() - began:.0f} s", flush=True)
     write_check(readme)
-    return [*write_blocks(plan, readme_tables(spec, readme, out)), str(README_RECORD.relative_to(ROOT))]
+    return [*readme_blocks(plan, spec, readme, out), str(README_RECORD.relative_to(ROOT))]
+
+
+def readme_blocks(plan: Plan, spec, readme: dict, out: Path) -> list[str]:
+    """Write the README tables' blocks; refused when no doc of the plan has the markers of one of them."""
+    written = write_blocks(plan, readme_tables(spec, readme, out))
+    missing = [name for name in README_BLOCKS if not any(line.endswith(f": {name}") for line in written)]
+    if missing:
+        raise SettingsError(f"no doc of the plan ({', '.join(plan.docs)}) has the markers of "
+                            + " or ".join(f"'{BEGIN_LINE.format(name=n)}'" for n in missing)
+                            + "; put them (and their end markers) where the table goes, then rerun with --render")
+    return written
 
 
 def mark_record(manifest: dict) -> list[str]:

@@ -23,6 +23,7 @@ from dialog.experiments.readme_tables import (
 from learning.errors import DataFileError, SettingsError
 
 
+@pytest.mark.e2e
 def test_the_readme_tables_were_made_by_the_code_as_it_is(tmp_path):
     spec = load_spec()
     record = json.loads(RECORD_FILE.read_text(encoding="utf-8"))
