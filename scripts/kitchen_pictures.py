@@ -1,5 +1,5 @@
-"""Regenerate the pictures of the three kitchens and of the teaching page in docs/ (docs/kitchen.md, docs/web.md
-and the README show them).
+"""Regenerate the pictures of the three kitchens and of the teaching page in docs/ (docs/kitchen.md and
+docs/web.md show them, the README the page's).
 
 For each kitchen: the overhead camera's annotated picture of a seeded scene with the arm
 (``docs/img/kitchens/kitchen-N-camera.png``, as `teachbot world show --png` draws it, at 3/4 size) and a view of

@@ -39,7 +39,8 @@ def test_the_readme_tables_were_made_by_the_code_as_it_is(tmp_path):
 def test_the_readme_has_both_blocks_stamped_and_no_typed_table_beside_them():
     text = (ROOT / "README.md").read_text(encoding="utf-8")
     assert {"summary:demo", "summary:study"} <= set(blocks_in(text))
-    for start, end in (("## The demo", "## Teaching at the terminal"), ("## User studies", "## Watching in the")):
+    sections = (("## Install and run", "## Teach the robot"), ("## Run a user study", "## Use the learning core"))
+    for start, end in sections:
         section = text[text.index(start):text.index(end)]
         assert unstamped_tables(section) == [], f"README.md, {start}: a table outside a stamped block"
     record = json.loads(RECORD_FILE.read_text(encoding="utf-8"))
@@ -75,7 +76,6 @@ def test_tables_are_cut_from_the_report_and_the_rows():
     with pytest.raises(SettingsError, match="no column 'mean'"):
         table_columns(report, "condition", ("mean",))
     spec = load_spec()
-    rows = [{"strategy": s, "seed": seed, "accuracy": 0.5 + seed / 10, "wall_seconds": 2.0}
-            for s, _ in spec.strategies for seed in (1, 0)]
-    table = demo_table(spec, {"demo": rows, "load_average": 1.5})
-    assert "| `dt-task` (the demo's) | 0.500 0.600 | 0.550 | 2.0 |" in table and "load average 1.5" in table
+    rows = [{"strategy": s, "seed": seed, "accuracy": 0.5 + seed / 10} for s, _ in spec.strategies for seed in (1, 0)]
+    table = demo_table(spec, {"demo": rows})
+    assert "| `dt-task` (the demo's) | 0.500 0.600 | 0.550 |" in table and "S = 0, 1" in table
