@@ -111,10 +111,10 @@ class ParticipantRun:
                     if lock is not None:
                         lock.release()
                 if self.show_conditions:
-                    self.write(f"Kept the earlier records as {', '.join(p.name for p in moved)}.")
-                else:  # the file names name the condition
+                    self.write(f"Kept the earlier records as {', '.join(str(p) for p in moved)}.")
+                else:  # the file names name the condition; the folder does not
                     self.write(f"Kept the earlier records of session {position} ({len(moved)} files, renamed "
-                               "*.superseded-N in the participant's folder).")
+                               f"*.superseded-N in {files.transcript.parent}).")
             return [position]
         if again:
             raise TranscriptError("--again needs --condition NAME: the one condition to run again")
