@@ -5,8 +5,9 @@ Both sides play the same frozen list of episodes (scripts/bench_sweep_episodes.t
 episode runner (``dialog.experiments.episodes.run_episode``: dialog manager, scripted teacher, pools, one
 BLAS thread). Each side runs in its own subprocess with its own code first on PYTHONPATH: this working tree,
 and the earlier commit unpacked by ``git archive`` into a temporary folder. Each side builds the episodes with
-its own classes from the same plain data, the fields not left at their defaults; a field that its code lacks
-and an episode sets is refused, so both sides always play the same episodes. The sides alternate round by
+its own classes from the same plain data, every field its code has given explicitly; a field its code lacks
+is left out only when the episode leaves it at this tree's default, else refused, so both sides always play
+the same episodes. The sides alternate round by
 round, so that the load of a shared machine falls on both alike. The time is the CPU time of every
 ``run_episode`` call, after a warm-up episode and with the pools loaded beforehand; the figure is turns
 played per CPU-second, and the ratio is this tree's over the earlier commit's.
@@ -49,20 +50,25 @@ from dialog.experiments.episodes import EpisodeSpec, run_episode
 from dialog.experiments.pools import load_pools
 from dialog.experiments.suite import Condition
 def built(cls, row, what):
-    # this code's own class from plain data; a field it lacks would make it play another episode: refused
-    unknown = sorted(set(row) - {f.name for f in fields(cls)})
-    if unknown:
-        sys.exit(f"{what} sets {', '.join(f'{k}={row[k]!r}' for k in unknown)}, which this code's {cls.__name__} "
-                 "does not have, so it cannot play the same episode")
-    return cls(**row)
-rows = json.load(sys.stdin)
+    # this code's own class from plain data, every field it has given; a field it lacks is left out only when the
+    # episode leaves it at its default (the default of the code that wrote the list), else refused: it would be
+    # another episode
+    known = {f.name for f in fields(cls)}
+    differing = sorted(k for k in set(row) - known if k not in defaults[cls.__name__]
+                       or row[k] != defaults[cls.__name__][k])
+    if differing:
+        sys.exit(f"{what} sets {', '.join(f'{k}={row[k]!r}' for k in differing)}, which this code's "
+                 f"{cls.__name__} does not have, so it cannot play the same episode")
+    values = {k: v for k, v in row.items() if k in known}
+    values.update({k: tuple(tuple(pair) for pair in values[k]) for k in ("costs", "teacher", "plan") if k in values})
+    return cls(**values)
+sent = json.load(sys.stdin)
+rows, defaults = sent["rows"], sent["defaults"]
 with tempfile.TemporaryDirectory(prefix="bench-sweep-") as folder:
     specs = []
     for index, row in enumerate(rows):
         what = f"episode {index + 1} ({row['suite']}/{row['strategy']})"
-        pairs = {key: tuple(tuple(pair) for pair in row[key]) for key in ("costs", "teacher", "plan") if key in row}
-        row.update(pairs, condition=built(Condition, row["condition"], what),
-                   transcript=str(Path(folder) / f"{index}.jsonl"))
+        row.update(condition=built(Condition, row["condition"], what), transcript=str(Path(folder) / f"{index}.jsonl"))
         specs.append(built(EpisodeSpec, row, what))
     for key in dict.fromkeys((s.task, s.kitchen, s.dataset + 1) for s in specs):
         load_pools(*key)
@@ -124,10 +130,8 @@ def unpack(commit: str, folder: Path) -> None:
 
 
 def episode_rows(quick: bool, count: int | None = None) -> list[dict]:
-    """The frozen episodes as plain data for the driver (its transcript paths are its own): only the fields
-    that differ from their defaults, so that an earlier commit's classes, which may lack later fields (issue 51:
-    ``Condition.until_budget_spent``), build the same episodes; a field the earlier code lacks and an episode
-    sets is refused by the driver."""
+    """The frozen episodes as plain data for the driver, which builds them with its own code's classes (its
+    transcript paths are its own)."""
     sys.path.insert(0, str(ROOT))
     from dialog.experiments.fingerprint import fingerprint_episodes
 
@@ -136,20 +140,30 @@ def episode_rows(quick: bool, count: int | None = None) -> list[dict]:
         episodes = [e for label in QUICK_EPISODES for e in episodes if e.label == label]
         episodes = [replace(e, spec=replace(e.spec, condition=replace(e.spec.condition, turns=QUICK_TURNS)))
                     for e in episodes]
-    return [{**_set_fields(e.spec), "condition": _set_fields(e.spec.condition)} for e in episodes[:count]]
+    return [{**_plain(e.spec), "condition": _plain(e.spec.condition)} for e in episodes[:count]]
 
 
-def _set_fields(instance) -> dict:
-    """A dataclass's fields as plain data, without those left at their defaults (and without the transcript)."""
-    values = asdict(instance)
-    return {f.name: values[f.name] for f in fields(instance)
-            if f.name != "transcript" and (f.default is MISSING or values[f.name] != f.default)}
+def _plain(instance) -> dict:
+    return {name: value for name, value in asdict(instance).items() if name != "transcript"}
+
+
+def field_defaults() -> dict:
+    """This tree's defaults of the episode classes' fields: an earlier commit's classes may lack later fields
+    (issue 51: ``Condition.until_budget_spent``); its driver leaves such a field out only when an episode
+    leaves it at this default, and refuses the episode otherwise, so both sides play the same episodes."""
+    sys.path.insert(0, str(ROOT))
+    from dialog.experiments.episodes import EpisodeSpec
+    from dialog.experiments.suite import Condition
+
+    return {cls.__name__: {f.name: f.default for f in fields(cls) if f.default is not MISSING}
+            for cls in (EpisodeSpec, Condition)}
 
 
 def play(code: Path, rows: list[dict], side: str) -> list[dict]:
     """Run the episodes with the code under ``code`` in a subprocess; each episode's turns and CPU seconds."""
     env = {**os.environ, "PYTHONPATH": str(code)}
-    done = subprocess.run([sys.executable, "-c", DRIVER, str(code)], input=json.dumps(rows), capture_output=True,
+    sent = {"rows": rows, "defaults": field_defaults()}
+    done = subprocess.run([sys.executable, "-c", DRIVER, str(code)], input=json.dumps(sent), capture_output=True,
                           text=True, env=env, cwd=code, check=False)
     if done.returncode != 0:
         last = (done.stderr.strip().splitlines() or ["no message"])[-1]
