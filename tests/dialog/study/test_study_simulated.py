@@ -48,7 +48,9 @@ def test_every_session_is_recorded_with_the_study_header(folder):
 
 def test_a_participant_who_is_done_is_refused_unless_asked(folder, capsys):
     assert study_cli(folder, "run", "--participant", "P01", "--simulated") == 2
-    assert "already done every session" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert "already done every session" in err
+    assert f"(see teachbot study status {EXAMPLE} --folder {folder}); to run one again" in err  # runs as printed
     assert study_cli(folder, "run", "--participant", "P01", "--simulated", "--condition", "active") == 2
     assert "--again" in capsys.readouterr().err
     assert study_cli(folder, "run", "--participant", "Jane Doe", "--simulated") == 2
