@@ -105,9 +105,16 @@ def stop_viewer(viewer) -> dict | None:
         print(f"warning: the viewer did not close cleanly ({type(error).__name__}: {error})", file=sys.stderr)
         return None
     if written:
-        print(f"Episode page: {written['path']} ({written['bytes'] / 1e6:.1f} MB, "
-              f"{written['seconds']:.0f} s of animation)", file=sys.stderr)
+        print(page_written("Episode page", written, f", {written['seconds']:.0f} s of animation"), file=sys.stderr)
     return written
+
+
+def page_written(label: str, written: dict, more: str = "") -> str:
+    """What an exported page is and how to open it (it needs no server, so no URL of one that has exited):
+    ``Page: scene.html (3.1 MB), one self-contained HTML file; open it in a web browser: file:///...``."""
+    path = Path(written["path"])
+    return (f"{label}: {path} ({written['bytes'] / 1e6:.1f} MB{more}), one self-contained HTML file that needs no "
+            f"server; open it in a web browser: {path.resolve().as_uri()}")
 
 
 def page_path(path: Path, name: str) -> Path:

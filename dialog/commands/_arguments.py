@@ -9,6 +9,7 @@ import textwrap
 from pathlib import Path
 
 from bullet_world.datafiles import available
+from dialog.printed_command import command_line
 from dialog.settings import DEFAULTS, EpisodeSettings
 from learning.errors import SettingsError, did_you_mean
 from learning.strategies import PLUGIN_FORM, RL_PREFIX, check_strategy_name, is_plugin_spec
@@ -75,15 +76,20 @@ def own_voice(message: str, prog: str) -> str:
         return f"{value.group(1)}: '{value.group(3)}' is not {what}"
     required = re.fullmatch(r"the following arguments are required: (.*)", message, re.S)
     if required:
-        return f"{required.group(1)} must be given (see {prog} --help)"
+        return f"{required.group(1)} must be given (see {_help_command(prog)})"
     unknown = re.fullmatch(r"unrecognized arguments: (.*)", message, re.S)
     if unknown:
-        return f"unknown argument(s) {unknown.group(1)} (see {prog} --help for the accepted ones)"
+        return f"unknown argument(s) {unknown.group(1)} (see {_help_command(prog)} for the accepted ones)"
     named = re.fullmatch(r"argument (\S+?)(?:/\S+)?: (.*)", message, re.S)
     if named:
         problem = "needs a value" if named.group(2) == "expected one argument" else named.group(2)
         return f"{named.group(1)}: {problem}"
     return message
+
+
+def _help_command(prog: str) -> str:
+    """``teachbot regress --help`` for argparse's ``prog`` "teachbot regress", runnable as printed."""
+    return command_line([*prog.split()[1:], "--help"])
 
 
 ASCII_WHOLE = re.compile(r"[+-]?[0-9]+")

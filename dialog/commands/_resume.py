@@ -3,9 +3,9 @@
 from __future__ import annotations
 
 import argparse
-import shlex
 from pathlib import Path
 
+from dialog.printed_command import command_line
 from dialog.user_weights import check_weights_unchanged, weights_from_header
 from learning.errors import TranscriptError
 
@@ -77,8 +77,9 @@ UNRECORDED_TEACH_OPTIONS = (("--pictures", "pictures"), ("--no-pictures", "no_pi
 
 
 def continue_command(words: list, args: argparse.Namespace | None = None, options=UNRECORDED_TEACH_OPTIONS) -> str:
-    """The command that goes on where a run stopped: ``words`` (the command and what names the run) plus every
-    option of ``options`` that ``args`` gave, shell-quoted so that it can be pasted as printed."""
+    """The command that goes on where a run stopped: the program as it was started, ``words`` (the command and
+    what names the run) and every option of ``options`` that ``args`` gave, runnable as printed
+    (``dialog.printed_command``)."""
     command = [str(word) for word in words]
     for option, attribute in options if args is not None else ():
         value = getattr(args, attribute, None)
@@ -89,4 +90,4 @@ def continue_command(words: list, args: argparse.Namespace | None = None, option
                 command += [option, str(item)]
         elif value not in (None, False):
             command += [option, f"{value:g}" if isinstance(value, float) else str(value)]
-    return shlex.join(command)
+    return command_line(command)

@@ -19,6 +19,7 @@ from dialog.commands._arguments import positive_int, seed
 from dialog.commands._json import print_json, strict_json
 from dialog.experiments.provenance import git_commit
 from dialog.output_paths import check_writable, file_argument, make_parent, writing
+from dialog.printed_command import command_line
 from dialog.user_weights import UserWeights
 from learning.errors import OutputPathError, SettingsError
 
@@ -162,8 +163,8 @@ def check_options(args: argparse.Namespace, method: str) -> None:
              "imitation": trajectory_only + per_turn_only}[method]
     wrong = [name for name, present in given if present]
     if wrong:
-        raise SettingsError(f"{', '.join(wrong)} do(es) not apply to --method {method}; see teachbot learn-weights "
-                            "--help for the options of each method")
+        raise SettingsError(f"{', '.join(wrong)} do(es) not apply to --method {method}; see "
+                            f"{command_line(['learn-weights', '--help'])} for the options of each method")
 
 
 def learn_imitation(args: argparse.Namespace, out):

@@ -7,7 +7,6 @@ does the work: load, run, report, check.
 from __future__ import annotations
 
 import argparse
-import shlex
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -25,6 +24,7 @@ from dialog.experiments.progress import EventProgress, Progress, SweepProgress
 from dialog.experiments.runner import episode_specs
 from dialog.experiments.suite import load_suite, suite_names
 from dialog.output_paths import check_writable, writing
+from dialog.printed_command import command_line
 from dialog.user_weights import named_weights, read_named_weights
 from learning.datafiles import inside
 from learning.errors import SettingsError
@@ -225,11 +225,11 @@ def run_on_data_seeds(args: argparse.Namespace, kind, suite, original, out: Path
             else:
                 print(done, flush=True)
     pooled = pooled_findings(suite, runs)
-    words = ["teachbot", "regress", "--suite", str(args.suite), "--data-seeds", *map(str, seeds)]
+    words = ["regress", "--suite", args.suite, "--data-seeds", *seeds]
     for option, values in (("--strategies", args.strategies), ("--seeds", args.seeds), ("--datasets", args.datasets)):
         if values is not None:
-            words += [option, *map(str, values if isinstance(values, list) else [values])]
-    command = shlex.join(words)
+            words += [option, *(values if isinstance(values, list) else [values])]
+    command = command_line(words)  # the report's record of the run, runnable as printed
     with writing(out, "results", inside=True):
         path = replication_report(suite, runs, pooled, out, command)
         write_replication_json(replication_summary(suite, runs, pooled, command), out)

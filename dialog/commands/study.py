@@ -4,8 +4,9 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
-import shlex
 from pathlib import Path
+
+from dialog.printed_command import command_line
 
 
 def register(subparsers) -> None:
@@ -91,7 +92,7 @@ def _run(args) -> int:
         raise SettingsError(f"--web is for a participant answering in the page; not with "
                             f"{'--simulated' if args.simulated else '--abort'}")
     study = _load(args)
-    again = continue_command(["teachbot", "study", "run", args.study, "--participant", args.participant], args,
+    again = continue_command(["study", "run", args.study, "--participant", args.participant], args,
                              RUN_OPTIONS + web_continue_options(args))
     viewer = False if args.no_viewer else None
     if args.abort is not None or not args.web:
@@ -131,7 +132,7 @@ def _dry_run_note(args, study, action: str) -> str:
     dry = study.folder.with_name(study.folder.name + SIMULATED_SUFFIX)
     if not any(dry.glob("*/*.jsonl")):
         return ""
-    command = shlex.join(["teachbot", "study", action, str(args.study), "--simulated"])
+    command = command_line(["study", action, args.study, "--simulated"])
     return (f"note: no session is recorded in {study.folder}; the simulated sessions (study run --simulated) are "
             f"in {dry}: {command}")
 

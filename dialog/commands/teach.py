@@ -199,7 +199,7 @@ def _teach(args, settings: SessionSettings, path: Path, lock: TranscriptLock, in
         if person and len(records) < settings.turns and not manager.out_of_time():
             _announce(manager, page, "Type 'help' at any question for what you can answer; 'quit' saves and stops.",
                       "")
-        again = continue_command(["teachbot", "teach", "--resume", path], args,
+        again = continue_command(["teach", "--resume", path], args,
                                  UNRECORDED_TEACH_OPTIONS + web_continue_options(args))
         try:
             result = manager.run(replay=records)

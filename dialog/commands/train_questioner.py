@@ -7,6 +7,7 @@ learning/rl/policy_file.py writes the policy (TOML + NPZ, no pickle).
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
 from dialog.commands._arguments import (
     add_kitchen_option,
@@ -87,12 +88,17 @@ def run(args: argparse.Namespace) -> int:
     with writing(args.out, "policy file"):
         save_policy(args.out, policy, "written by teachbot train-questioner: a masked PPO questioning policy\n"
                                       "run it with --strategy rl:" + str(args.out))
-    print(f"{summary['steps']} steps, {summary['episodes']} episodes in {summary['seconds']:.0f} s (estimated "
-          f"{summary['estimated_seconds']:.0f} s); "
-          f"{final_accuracy_words(summary)}; wrote {args.out} and {args.out.with_suffix('.npz').name}")
+    print(trained_words(summary, args.out))
     if args.json:
         print_json({"out": str(args.out), **summary})
     return 0
+
+
+def trained_words(summary: dict, out: Path) -> str:
+    """The last line: steps, episodes, time, final accuracy and the two files written, both with their folder."""
+    return (f"{summary['steps']} steps, {summary['episodes']} episodes in {summary['seconds']:.0f} s (estimated "
+            f"{summary['estimated_seconds']:.0f} s); {final_accuracy_words(summary)}; wrote {out} and "
+            f"{out.with_suffix('.npz')}")
 
 
 def final_accuracy_words(summary: dict) -> str:

@@ -46,7 +46,7 @@ def run(args: argparse.Namespace) -> int:
     from dialog.environment import SimulatedKitchen
     from dialog.manager import episode_generators
     from dialog.output_paths import check_writable, writing
-    from dialog.viewer import page_path
+    from dialog.viewer import page_path, page_written
 
     export = None
     if args.export is not None:
@@ -72,17 +72,19 @@ def run(args: argparse.Namespace) -> int:
                   f"{scene.n_objects} objects, numbered 1 to {scene.n_objects}.")
             for line in scene_table(scene, environment):
                 print(f"  {line}")
-            print(f"Viewer: {viewer.url}")
+            serving = _serving_seconds(args)
+            if serving != 0:  # a URL only for a server that outlives this line (issue 51)
+                print(f"Viewer: {viewer.url}")
             if export is not None:
                 with writing(export, "scene page"):
                     written = viewer.export_html(export, title=f"teachbot {args.task} seed {args.seed}")
-                print(f"Page: {written['path']} ({written['bytes'] / 1e6:.1f} MB)")
+                print(page_written("Page", written))
             if args.screenshot is not None:
                 from bullet_world.viewer.snapshot import screenshot
 
                 shot = screenshot(viewer.url, args.screenshot, min_drawn=scene.n_objects + 2)
                 print(f"Picture: {shot['path']} ({shot['drawn']} meshes and labels drawn)")
-            _serve(_serving_seconds(args))
+            _serve(serving)
         finally:
             viewer.close()
     finally:

@@ -11,12 +11,12 @@ from __future__ import annotations
 
 import argparse
 import json
-import shlex
 import sys
 from dataclasses import dataclass, field
 
 from dialog.environment import SimulatedKitchen
 from dialog.output_paths import check_writable
+from dialog.printed_command import command_line
 from dialog.session import SessionSettings, open_session
 from dialog.study import questionnaire
 from dialog.study.design import assigned_orders, questionnaire_rng, session_seed
@@ -67,9 +67,8 @@ class ParticipantRun:
         self.out = output_stream if output_stream is not None else sys.stdout
         self.reader = LineReader(self.input_stream)
         self.viewer = viewer
-        self.continue_command = continue_command or shlex.join(  # what the "continue with" line says
-            ["teachbot", "study", "run", str(study.path), "--participant", participant]
-            + (["--simulated"] if simulated else []))
+        self.continue_command = continue_command or command_line(  # what the "continue with" line says
+            ["study", "run", study.path, "--participant", participant] + (["--simulated"] if simulated else []))
         self.show_conditions = show_conditions  # condition names, strategies, budgets: for a pilot only
         self.page = page  # a dialog.web.session.WebPage: the participant answers in the browser
         if page is not None:
@@ -112,10 +111,10 @@ class ParticipantRun:
                     if lock is not None:
                         lock.release()
                 if self.show_conditions:
-                    self.write(f"Kept the earlier records as {', '.join(p.name for p in moved)}.")
-                else:  # the file names name the condition
+                    self.write(f"Kept the earlier records as {', '.join(str(p) for p in moved)}.")
+                else:  # the file names name the condition; the folder does not
                     self.write(f"Kept the earlier records of session {position} ({len(moved)} files, renamed "
-                               "*.superseded-N in the participant's folder).")
+                               f"*.superseded-N in {files.transcript.parent}).")
             return [position]
         if again:
             raise TranscriptError("--again needs --condition NAME: the one condition to run again")
@@ -124,8 +123,9 @@ class ParticipantRun:
             if states[position - 1].state == "damaged":
                 self._refuse_damaged(position, states[position - 1])
         if not todo:
+            status = command_line(["study", "status", self.study.path, "--folder", self.study.folder])
             raise TranscriptError(f"{self.participant} has already done every session of study '{self.study.name}' "
-                                  f"(see teachbot study status); to run one again: --condition NAME --again")
+                                  f"(see {status}); to run one again: --condition NAME --again")
         return todo
 
     def abort(self, reason: str) -> int:

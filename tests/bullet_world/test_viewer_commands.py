@@ -93,3 +93,18 @@ def test_view_rejects_an_object_number_outside_the_scene(capsys):
 
     assert main(["view", "--seed", "2", "--point", "40", "--seconds", "0"]) == 2
     assert "--point 40: the scene has objects 1 to" in capsys.readouterr().err
+
+
+def test_view_export_names_its_page_and_how_to_open_it_and_no_url_of_a_server_that_exits(tmp_path, capsys,
+                                                                                          monkeypatch):
+    """Issue 51: the command returns once the page is written, so the page is what it points to, not the URL."""
+    from dialog.cli import main
+
+    monkeypatch.chdir(tmp_path)
+    assert main(["view", "--seed", "2", "--export", "scene.html"]) == 0
+    out = capsys.readouterr().out
+    assert "Viewer:" not in out and "http://" not in out and "Serving" not in out
+    (line,) = [line for line in out.splitlines() if line.startswith("Page: ")]
+    assert line.startswith("Page: scene.html (") and "one self-contained HTML file that needs no server" in line
+    assert line.endswith(f"open it in a web browser: {(tmp_path / 'scene.html').as_uri()}")
+    assert (tmp_path / "scene.html").stat().st_size > 10_000

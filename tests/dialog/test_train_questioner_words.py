@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 
-from dialog.commands.train_questioner import final_accuracy_words
+from dialog.commands.train_questioner import final_accuracy_words, trained_words
 
 
 def test_the_final_accuracy_names_the_episodes_it_averages():
@@ -16,6 +18,15 @@ def test_the_final_accuracy_names_the_episodes_it_averages():
         "final accuracy of the one training episode 0.500"
     assert "no training episode ended" in final_accuracy_words(
         {"episodes": 0, "final_accuracy_episodes": 0, "final_accuracy_last_50": None})
+
+
+def test_the_last_line_names_both_files_with_their_folder():
+    """Issue 51: ``--out DIR/small.toml`` said "wrote DIR/small.toml and small.npz", the npz being in DIR too."""
+    summary = {"steps": 256, "episodes": 32, "seconds": 79.2, "estimated_seconds": 80.0, "final_accuracy_episodes": 32,
+               "final_accuracy_last_50": 0.424}
+    assert trained_words(summary, Path("runs/rl/small.toml")) == (
+        "256 steps, 32 episodes in 79 s (estimated 80 s); final accuracy of all 32 training episodes 0.424; "
+        "wrote runs/rl/small.toml and runs/rl/small.npz")
 
 
 def test_training_says_it_loads_the_data_sets_before_it_does(monkeypatch):

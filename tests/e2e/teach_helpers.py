@@ -1,12 +1,16 @@
 """Drive ``teachbot teach`` through a pseudo-terminal (pexpect), as a person would."""
 
 import os
+import shlex
 import sys
 from pathlib import Path
 
 import pexpect
 
+from dialog.printed_command import program
+
 TEACHBOT = str(Path(sys.executable).with_name("teachbot"))
+PRINTED = shlex.join(program(TEACHBOT))  # how TEACHBOT, started by its full path, names itself in printed commands
 QUESTIONS = {"feature": "Which features tell", "demo": "Can you show me", "label": "What is the"}
 
 

@@ -25,7 +25,8 @@ def test_view_points_at_an_object_and_photographs_the_pointing_moment(tmp_path, 
                  "--seconds", "0"])
     out = capsys.readouterr().out
     assert code == 0
-    assert "The arm points at object 5" in out and "Viewer: http://127.0.0.1:" in out
+    assert "The arm points at object 5" in out and "Viewer:" not in out  # its server is gone when the command ends
+    assert f"Page: {page} (" in out and f"open it in a web browser: {page.as_uri()}" in out
     assert page.stat().st_size > 1_000_000  # the Panda's meshes, the objects, the motion
     rgb = np.asarray(Image.open(picture).convert("RGB"), dtype=float)
     r, g, b = rgb[..., 0], rgb[..., 1], rgb[..., 2]

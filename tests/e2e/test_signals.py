@@ -15,6 +15,8 @@ from pathlib import Path
 
 import pytest
 
+from tests.e2e.teach_helpers import PRINTED
+
 pytestmark = pytest.mark.e2e
 
 TEACHBOT = str(Path(sys.executable).with_name("teachbot"))
@@ -96,7 +98,7 @@ def test_ctrl_c_in_the_teaching_loop_prints_the_resume_hint_once(tmp_path):
     os.killpg(process.pid, signal.SIGINT)
     code, output = finish(process, earlier)
     assert_interrupted_cleanly(code, output)
-    assert f"teachbot teach --resume {transcript}" in output
+    assert f"{PRINTED} teach --resume {transcript}" in output
     assert transcript.read_text().count("\n") >= 2  # the header and the turns so far, each a whole line
 
 

@@ -10,7 +10,7 @@ import pexpect
 import pytest
 
 from dialog.transcripts.jsonl import read_session
-from tests.e2e.teach_helpers import answer, next_question
+from tests.e2e.teach_helpers import PRINTED, answer, next_question
 
 pytestmark = pytest.mark.e2e
 TEACHBOT = str(Path(sys.executable).with_name("teachbot"))
@@ -84,7 +84,7 @@ def test_a_participant_runs_a_session_and_a_questionnaire_at_the_terminal(tmp_pa
     child.sendline("")
     assert next_question(child) == "label"
     child.sendeof()  # the participant leaves mid-session: it is saved and resumes later
-    child.expect_exact("Continue with: teachbot study run study.toml --participant T01 --no-viewer")
+    child.expect_exact(f"Continue with: {PRINTED} study run study.toml --participant T01 --no-viewer")
     child.expect(pexpect.EOF)
     child.close()
     assert child.exitstatus == 0
@@ -141,10 +141,10 @@ def test_the_continue_line_repeats_the_folder_and_runs_as_printed(tmp_path):
     child.sendline("")
     assert next_question(child) == "label"
     child.sendeof()
-    child.expect(r"Continue with: (teachbot study run [^\r\n]+)")
+    child.expect(r"Continue with: ([^\r\n]+)")
     printed = child.match.group(1).strip()
     child.expect(pexpect.EOF)
-    assert printed == "teachbot study run study.toml --participant T02 --folder pilot --no-viewer"
+    assert printed == f"{PRINTED} study run study.toml --participant T02 --folder pilot --no-viewer"
     words = shlex.split(printed)
     again = pexpect.spawn(TEACHBOT, words[1:], cwd=str(tmp_path), env=dict(os.environ, TERM="dumb", NO_COLOR="1"),
                           encoding="utf-8", timeout=120, dimensions=(50, 200))

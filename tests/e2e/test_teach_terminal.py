@@ -4,7 +4,7 @@ import pexpect
 import pytest
 
 from dialog.transcripts.jsonl import read_session
-from tests.e2e.teach_helpers import answer, next_question, spawn
+from tests.e2e.teach_helpers import PRINTED, answer, next_question, spawn
 
 pytestmark = pytest.mark.e2e
 
@@ -71,10 +71,10 @@ def test_the_continue_line_repeats_unrecorded_options_and_runs_as_printed(tmp_pa
     child = spawn("--turns", "3", "--transcript", "my session.jsonl", "--pictures", "pics", cwd=tmp_path)
     next_question(child)
     child.sendeof()
-    child.expect(r"Continue it with: (teachbot teach [^\r\n]+)")
+    child.expect(r"Continue it with: ([^\r\n]+)")
     printed = child.match.group(1).strip()
     child.expect(pexpect.EOF)
-    assert printed == "teachbot teach --resume 'my session.jsonl' --pictures pics"
+    assert printed == f"{PRINTED} teach --resume 'my session.jsonl' --pictures pics"
     again = spawn(*shlex.split(printed)[2:], cwd=tmp_path)
     again.expect_exact("Transcript: my session.jsonl")
     next_question(again)

@@ -18,6 +18,7 @@ import tornado.websocket
 
 from dialog.commands._resume import UNRECORDED_TEACH_OPTIONS, continue_command
 from dialog.web.session import web_continue_options
+from tests.e2e.teach_helpers import PRINTED
 from tests.e2e.web_helpers import WebCommand
 
 pytestmark = pytest.mark.e2e
@@ -31,7 +32,7 @@ def web_args(**given) -> argparse.Namespace:
 
 
 def test_the_continue_command_repeats_the_page_options_that_were_given():
-    words = ["teachbot", "teach", "--resume", "runs/t.jsonl"]
+    words = ["teach", "--resume", "runs/t.jsonl"]
     assert continue_command(words, web_args(), UNRECORDED_TEACH_OPTIONS + web_continue_options(web_args())) == \
         "teachbot teach --resume runs/t.jsonl --web"
     given = web_args(port=8765, origin=["https://a.example", "https://b.example"], no_3d=True)
@@ -107,7 +108,7 @@ def test_quit_in_the_page_keeps_web_in_the_continue_command_and_the_page_says_so
         assert command.finish(90) == 0
     finally:
         command.stop()
-    again = "Continue it with: teachbot teach --resume runs/t.jsonl --web --no-3d"
+    again = f"Continue it with: {PRINTED} teach --resume runs/t.jsonl --web --no-3d"
     assert any(again in line for line in command.out), "".join(command.out)
     assert page.ended is not None and "The session is saved after 1 of 3 turns" in page.ended
     assert "The robot now names" in page.ended and "teachbot" not in page.ended and "--resume" not in page.ended
@@ -128,7 +129,7 @@ def test_ctrl_c_at_the_terminal_keeps_web_and_the_page_says_it_was_interrupted(t
         assert command.finish(90) == 130
     finally:
         command.stop()
-    again = "continue it with: teachbot teach --resume runs/t.jsonl --web --no-3d"
+    again = f"continue it with: {PRINTED} teach --resume runs/t.jsonl --web --no-3d"
     assert any(again in line for line in command.out), "".join(command.out)
     assert page.ended is not None and page.ended.startswith("The session was interrupted.")
     assert "teachbot" not in page.ended and ".jsonl" not in page.ended

@@ -28,6 +28,7 @@ from dialog.environment import SimulatedKitchen
 from dialog.manager import episode_generators
 from dialog.transcripts.jsonl import read_session
 from tests.e2e.plain_words import check_screen, decimals_in, researcher_words_in
+from tests.e2e.teach_helpers import PRINTED
 from tests.e2e.web_helpers import TEACHBOT, WebCommand, chromium, comparable, open_page, send_raw, wait_for_question
 
 pytestmark = [
@@ -204,7 +205,7 @@ def test_a_whole_session_in_the_browser_equals_the_same_answers_typed(tmp_path):
                 assert any("Session saved after 5 of 8 turns" in line for line in first.out)
                 terminal_text = "".join(first.out)  # the researcher's: the strategy, the file, the command
                 assert "strategy dt-task" in terminal_text and "Transcript: runs/t.jsonl" in terminal_text
-                assert "teachbot teach --resume runs/t.jsonl --web" in terminal_text
+                assert f"{PRINTED} teach --resume runs/t.jsonl --web" in terminal_text
             finally:
                 first.stop()
 

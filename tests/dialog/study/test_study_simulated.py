@@ -48,7 +48,9 @@ def test_every_session_is_recorded_with_the_study_header(folder):
 
 def test_a_participant_who_is_done_is_refused_unless_asked(folder, capsys):
     assert study_cli(folder, "run", "--participant", "P01", "--simulated") == 2
-    assert "already done every session" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert "already done every session" in err
+    assert f"(see teachbot study status {EXAMPLE} --folder {folder}); to run one again" in err  # runs as printed
     assert study_cli(folder, "run", "--participant", "P01", "--simulated", "--condition", "active") == 2
     assert "--again" in capsys.readouterr().err
     assert study_cli(folder, "run", "--participant", "Jane Doe", "--simulated") == 2
@@ -75,11 +77,13 @@ def test_an_interrupted_participant_resumes_where_they_stopped(folder, tmp_path)
     assert (person / f"1-{order[0]}.jsonl").stat().st_mtime == (folder / "P02" / f"1-{order[0]}.jsonl").stat().st_mtime
 
 
-def test_a_condition_run_again_keeps_the_old_records(folder, tmp_path):
+def test_a_condition_run_again_keeps_the_old_records(folder, tmp_path, capsys):
     copy = tmp_path / "records"
     shutil.copytree(folder, copy)
     first = assigned_orders(load_study(EXAMPLE))["P03"][0]
     assert study_cli(copy, "run", "--participant", "P03", "--simulated", "--condition", first, "--again") == 0
+    kept = [line for line in capsys.readouterr().out.splitlines() if line.startswith("Kept the earlier records")]
+    assert kept == [f"Kept the earlier records of session 1 (2 files, renamed *.superseded-N in {copy / 'P03'})."]
     again = copy / "P03" / f"1-{first}.jsonl"
     assert again.with_name(f"{again.name}.superseded-1").read_text() == again.read_text()  # same seed, same session
 
