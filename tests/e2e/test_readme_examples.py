@@ -54,7 +54,6 @@ SKIPPED = {
     "teachbot demo --web": "waits for a browser to open the page (tests/e2e/test_web_demo.py opens it in Chromium)",
     "teachbot study run dialog/data/studies/example.toml --participant P01": "a participant at the terminal",
     "teachbot view --task pack-lunchbox --seed 0": "serves the viewer until Ctrl-C, as the README says",
-    "teachbot regress --suite ch6-dynamic": "runs long (the chapter-6 suite, minutes on every core)",
     "teachbot regress --suite recipes": "runs long (2,040 recipe trials)",
     "teachbot learn-weights --demos shipped --out w.toml --json":
         "runs long (trajectory IRL: 100 iterations of dialog rollouts, about 10 minutes on 2 cores)",
