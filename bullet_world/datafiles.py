@@ -8,14 +8,21 @@ what is accepted.
 from __future__ import annotations
 
 import os
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
+
+try:
+    import fcntl
+except ImportError:  # not on POSIX
+    fcntl = None  # type: ignore[assignment]
 
 from learning.datafiles import numbers
 from learning.datafiles import read_toml as read_data_file
 from learning.errors import DataFileError
 
-__all__ = ["CACHE_ENV", "DATA_DIR", "DataFileError", "available", "cache_dir", "colour_list", "read_toml", "resolve",
-           "write_atomically"]
+__all__ = ["CACHE_ENV", "DATA_DIR", "DataFileError", "available", "cache_dir", "colour_list", "one_builder",
+           "read_toml", "resolve", "write_atomically"]
 
 DATA_DIR = Path(__file__).parent / "data"
 CACHE_ENV = "TEACHBOT_CACHE"
@@ -68,6 +75,22 @@ def cache_dir(override: str | Path | None = None) -> Path:
         path = base / "teachbot"
     path.mkdir(parents=True, exist_ok=True)
     return path
+
+
+@contextmanager
+def one_builder(lock: Path) -> Iterator[None]:
+    """Hold the exclusive lock file ``lock`` while a cached file is built: two processes that need the same file
+    (two test workers, two ``regress`` runs) build it once, the second waiting and then reading it."""
+    lock.parent.mkdir(parents=True, exist_ok=True)
+    if fcntl is None:  # no advisory locks here: both may build, and write_atomically keeps the file whole
+        yield
+        return
+    with open(lock, "a+b") as handle:
+        fcntl.flock(handle, fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(handle, fcntl.LOCK_UN)
 
 
 def write_atomically(path: Path, data: bytes) -> None:

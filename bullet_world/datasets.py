@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from bullet_world.catalogue import DatasetPlan, load_task
-from bullet_world.datafiles import DATA_DIR, cache_dir, resolve, write_atomically
+from bullet_world.datafiles import DATA_DIR, cache_dir, one_builder, resolve, write_atomically
 from bullet_world.world import World
 from learning.errors import SettingsError
 
@@ -164,13 +164,26 @@ def load_datasets(task: str, kitchen: str = "kitchen-1", seed: int = 0, plan: Da
     folder = cache_dir(cache) / "datasets"
     stem = f"{task}-{kitchen}-seed{seed}-{key}"
     npz_path, json_path = folder / f"{stem}.npz", folder / f"{stem}.json"
-    if not rebuild and npz_path.exists() and json_path.exists():
-        try:
-            return _load(npz_path, json_path)
-        except (OSError, ValueError, KeyError) as error:
-            if progress:
-                progress(f"cached data set {npz_path.name} is unreadable ({error}); building it again")
-    datasets = build_datasets(task, kitchen, seed, plan, robot_factory, progress)
-    datasets = replace(datasets, metadata=datasets.metadata | {"generator": key, "file": str(npz_path)})
-    _save(datasets, npz_path, json_path)
+    cached = None if rebuild else _cached(npz_path, json_path, progress)
+    if cached is not None:
+        return cached
+    with one_builder(folder.parent / "locks" / f"{stem}.lock"):  # another process may be building it: wait, then read
+        cached = None if rebuild else _cached(npz_path, json_path)
+        if cached is not None:
+            return cached
+        datasets = build_datasets(task, kitchen, seed, plan, robot_factory, progress)
+        datasets = replace(datasets, metadata=datasets.metadata | {"generator": key, "file": str(npz_path)})
+        _save(datasets, npz_path, json_path)
     return datasets
+
+
+def _cached(npz_path: Path, json_path: Path, progress=None) -> TaskDatasets | None:
+    """The cached data sets, or None when they are missing or unreadable (then they are built again)."""
+    if not (npz_path.exists() and json_path.exists()):
+        return None
+    try:
+        return _load(npz_path, json_path)
+    except (OSError, ValueError, KeyError) as error:
+        if progress:
+            progress(f"cached data set {npz_path.name} is unreadable ({error}); building it again")
+        return None

@@ -56,3 +56,27 @@ def test_an_unreadable_cache_file_is_rebuilt(tmp_path):
     messages = []
     again = load_datasets("pack-lunchbox", plan=plan, cache=tmp_path, progress=messages.append)
     assert np.array_equal(again.test.X, first.test.X) and "unreadable" in messages[0]
+
+
+BUILD_ONE = """
+import sys
+from bullet_world.catalogue import DatasetPlan
+from bullet_world.datasets import load_datasets
+plan = DatasetPlan(pools=1, pool_size=4, test_size=4, objects_per_scene=4)
+built = []
+load_datasets("pack-lunchbox", plan=plan, cache=sys.argv[1], progress=built.append)
+print(len(built))
+"""
+
+
+def test_two_processes_needing_the_same_data_set_build_it_once(tmp_path):
+    """Test workers and parallel runs share the cache: the second waits for the first's file instead of
+    rendering the same scenes again."""
+    import subprocess
+    import sys
+
+    runs = [subprocess.Popen([sys.executable, "-c", BUILD_ONE, str(tmp_path)], stdout=subprocess.PIPE, text=True)
+            for _ in range(2)]
+    messages = sorted(int(run.communicate(timeout=300)[0].strip()) for run in runs)
+    assert messages[0] == 0 and messages[1] > 0  # one built (and said so), the other only read
+    assert len(list((tmp_path / "datasets").glob("*.npz"))) == 1
