@@ -17,10 +17,14 @@ $(STAMP): pyproject.toml
 demo: $(STAMP)
 	$(VENV)/bin/teachbot demo --seed 0 --turns 30 --budget 40 --change-every 5 --strategy dt-task
 
+# pytest runs on every core (pytest-xdist; TEST_WORKERS=0 for one process), idle workers taking queued tests
+# from busy ones.
+TEST_WORKERS ?= auto
+
 test: $(STAMP)
 	$(VENV)/bin/ruff check .
 	$(VENV)/bin/mypy
-	$(PY) -m pytest --durations=25; status=$$?; \
+	$(PY) -m pytest -n $(TEST_WORKERS) --dist worksteal --durations=25; status=$$?; \
 	if [ $$status -eq 5 ]; then echo "pytest collected no tests: that is a failure here"; exit 1; fi; \
 	exit $$status
 
