@@ -47,7 +47,7 @@ HOUSE = ("bullet_world", "robot", "learning", "dialog")
 SCRIPTS = "scripts"  # not a package: a script imports its siblings by their bare names (scripts/ is on sys.path)
 # dialog/'s layers, lowest first: a module imports only modules of its own layer or of a lower one
 DIALOG_LAYERS = (
-    ("dialog.clock", "dialog.threads", "dialog.interrupts", "dialog.output_paths"),
+    ("dialog.clock", "dialog.threads", "dialog.interrupts", "dialog.output_paths", "dialog.printed_command"),
     ("dialog.language", "dialog.environment"),
     ("dialog.teachers",),
     ("dialog.transcripts",),

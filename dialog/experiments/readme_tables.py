@@ -24,6 +24,7 @@ from pathlib import Path
 
 from dialog.experiments.doc_tables import stamp
 from dialog.experiments.fingerprint import ROOT, digest, located_nowhere
+from dialog.printed_command import NAME as PROGRAM  # the README's commands name the installed program
 from learning.datafiles import check_keys, integer, read_toml, section, tables, text, texts
 from learning.errors import DataFileError, SettingsError
 
@@ -82,18 +83,18 @@ def load_spec(path: Path = SPEC_FILE) -> ReadmeSpec:
 
 
 def demo_command(spec: ReadmeSpec, strategy: str, seed: int, transcript: Path) -> list[str]:
-    return ["teachbot", "demo", *spec.demo_options, "--strategy", strategy, "--seed", str(seed),
+    return [PROGRAM, "demo", *spec.demo_options, "--strategy", strategy, "--seed", str(seed),
             "--transcript", str(transcript), "--json"]
 
 
 def study_commands(spec: ReadmeSpec, participants, folder: Path) -> list[list[str]]:
     """One ``study run --simulated`` per participant; the report is :func:`report_command`."""
-    return [["teachbot", "study", "run", spec.study, "--participant", p, "--simulated", "--no-viewer",
+    return [[PROGRAM, "study", "run", spec.study, "--participant", p, "--simulated", "--no-viewer",
              "--folder", str(folder)] for p in participants]
 
 
 def report_command(spec: ReadmeSpec, folder: Path) -> list[str]:
-    return ["teachbot", "study", "report", spec.study, "--simulated", "--folder", str(folder)]
+    return [PROGRAM, "study", "report", spec.study, "--simulated", "--folder", str(folder)]
 
 
 def run_cli(words: list[str]) -> str:
