@@ -197,7 +197,19 @@ def test_a_whole_session_in_the_browser_equals_the_same_answers_typed(tmp_path):
                     channels.append(answer(page, question, truth, keyboard=question["turn"] == 1))
                     done_turns += 1
                     question = wait_for_question(page, after=question["id"])
+                # a stray key cannot end it (issue 50): a click on the page background, then q, asks first
+                page.mouse.click(5, page.viewport_size["height"] - 5)
+                page.keyboard.press("q")
+                assert page.is_visible("#confirm") and "Stop this session?" in page.inner_text("#confirm")
+                assert page.evaluate("() => document.activeElement.id") == "confirm-go-on"  # the default
+                page.keyboard.press("Enter")  # Go on
+                assert page.is_hidden("#confirm") and page.evaluate("() => waiting && !ended")
+                page.keyboard.press("q")
+                page.keyboard.press("Escape")  # Go on, too
+                assert page.is_hidden("#confirm") and page.evaluate("() => waiting && !ended")
+                assert page.evaluate("() => question.id") == question["id"]
                 page.get_by_role("button", name="Quit").click()
+                page.keyboard.press("y")  # meant: the session ends as before
                 page.wait_for_function("() => ended")
                 assert "saved after 5 of 8 turns" in check_screen(page, "quit", seen, (why,))
                 assert first.finish() == 0

@@ -187,6 +187,7 @@ function sendFeatures(mode) {
 
 function setWaiting(on) {
   if (waiting && !on) { busySince = performance.now(); }
+  if (!on) { $("confirm").hidden = true; }  // no question open: nothing to stop from here
   const asking = !waiting && Boolean(on) && !ended;
   waiting = Boolean(on) && !ended;
   if (asking && question) { afterPaint(question.id); }
@@ -235,6 +236,18 @@ function showScreen(screen) {
     box.appendChild(p);
   });
   const form = document.createElement("form");
+  if (screen.choices && screen.choices.length) {  // answered by one of its buttons (the consent)
+    const buttons = screen.choices.map((choice) => button(choice, "", () => {
+      socket.send(JSON.stringify({type: "screen", screen: screen.id, answers: [], choice}));
+      buttons.forEach((b) => { b.disabled = true; });
+    }, true));
+    form.className = "choices";
+    form.append(...buttons);
+    box.appendChild(form);
+    heading.tabIndex = -1;
+    heading.focus();  // no choice is made by a stray Enter
+    return;
+  }
   (screen.items || []).forEach((item, i) => form.appendChild(questionnaireItem(item, i)));
   const submit = button(screen.button || "Continue", "", () => {
     const answers = (screen.items || []).map((item, i) => {
@@ -409,15 +422,41 @@ function objectAt(event) {
   return null;
 }
 
+// -- quitting has to be meant: "Stop this session?", with "Go on" the default ----------------------------
+function confirmOpen() { return !$("confirm").hidden; }
+
+function askToQuit() {
+  if (!question || !waiting) { return; }
+  $("confirm").hidden = false;
+  $("confirm-go-on").disabled = $("confirm-stop").disabled = false;
+  $("confirm-go-on").focus();  // Enter, Space or Escape go on; only "y" (or the button) stops
+}
+
+function closeConfirm(stop) {
+  if (!confirmOpen()) { return; }
+  $("confirm").hidden = true;
+  if (stop) { send({type: "command", command: "quit"}); }
+}
+
+$("confirm-go-on").addEventListener("click", () => closeConfirm(false));
+$("confirm-stop").addEventListener("click", () => closeConfirm(true));
+
 document.addEventListener("keydown", (event) => {
-  if (event.target.tagName === "INPUT" || event.target.tagName === "TEXTAREA" || event.ctrlKey || event.altKey || event.metaKey) { return; }
+  if (event.ctrlKey || event.altKey || event.metaKey) { return; }
+  if (confirmOpen()) {  // while the page asks whether to stop, only its answers count
+    if (event.key === "y" || event.key === "Y") { event.preventDefault(); closeConfirm(true); }
+    else if (["Escape", "n", "N", "g", "G"].includes(event.key)) { event.preventDefault(); closeConfirm(false); }
+    else if (event.key !== "Enter" && event.key !== " " && event.key !== "Tab") { event.preventDefault(); }
+    return;
+  }
+  if (event.target.tagName === "INPUT" || event.target.tagName === "TEXTAREA") { return; }
   const target = document.querySelector(`#ask button[data-key="${CSS.escape(event.key)}"]`);
   if (target && !target.disabled) { event.preventDefault(); target.click(); }
 });
 
 $("commands").addEventListener("click", (event) => {
   const command = event.target.closest("button")?.dataset.command;
-  if (command) { send({type: "command", command}); }
+  if (command === "quit") { askToQuit(); } else if (command) { send({type: "command", command}); }
 });
 
 $("typed").addEventListener("submit", (event) => {
