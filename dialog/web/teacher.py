@@ -235,6 +235,22 @@ class WebTeacher:
             except queue.Empty:
                 continue
 
+    def ask_choice(self, title: str, text: str, choices: tuple[str, ...]) -> str:
+        """Show a study screen that ends with one of ``choices`` (a button each; the consent's "I agree" and "I do
+        not agree") and wait for the one pressed."""
+        with self._lock:
+            self._question += 1
+            self._screen = {"id": self._question, "title": title, "text": text, "button": "", "items": [],
+                            "choices": list(choices)}
+            self.current, self._asked = None, None
+            screen = dict(self._screen)
+        self._post({"type": "screen", "screen": screen})
+        while True:
+            try:
+                return self._screen_answers.get(timeout=POLL_S)[0]
+            except queue.Empty:
+                continue
+
     # -- from the server's thread -----------------------------------------------------------------
     def submit(self, raw: str | bytes) -> str | None:
         """Check one message from a page; queue its line. Returns None, or the reason it was refused (logged)."""
