@@ -270,6 +270,7 @@ class ParticipantRun:
 
             want_viewer = condition.viewer if self.viewer is None else self.viewer
             if self.page is not None:  # the page shows this session's kitchen (its 3D view unless --no-viewer)
+                self.page.teacher.new_session()  # and only this session's conversation
                 self.page.three_d = self.viewer is not False
                 self.page.attach(environment)
             elif want_viewer and person:

@@ -36,13 +36,18 @@ def click_through(page, titles: list[str], seen: dict | None = None) -> int:
     """Answer every screen and question by clicking until the run ends; returns the questions answered. Each
     screen's visible text is checked for the researcher's words (``seen``: each kind of screen's last text)."""
     answered, seen = 0, {} if seen is None else seen
+    fresh = False  # the first question of a session is next
     while True:
         page.wait_for_function(READY, timeout=120_000)
         if page.evaluate("() => ended"):
             check_screen(page, "end", seen)
+            assert page.is_hidden("#views") and page.is_hidden("#commands") and page.is_hidden("#typed")
             return answered
         if not page.locator("#screen").is_hidden():
+            # between sessions: no kitchen, no stale picture, no greyed answer controls (issue 50)
+            assert page.is_hidden("#views") and page.is_hidden("#ask")
             titles.append(page.inner_text("#screen h2"))
+            fresh = titles[-1].startswith(("Session", "Practice"))
             kind = {"A short break": "pause", "A few questions about this session": "questionnaire",
                     "Before we begin": "consent"}.get(titles[-1], "instructions")
             check_screen(page, kind, seen)
@@ -58,6 +63,11 @@ def click_through(page, titles: list[str], seen: dict | None = None) -> int:
             continue
         question = page.evaluate("() => question")
         check_screen(page, f"{question['expects']} question", seen)
+        if fresh:  # a new session's conversation starts empty: nothing answered yet (the transcript keeps all)
+            assert "You: " not in page.inner_text("#conversation"), page.inner_text("#conversation")
+            fresh = False
+        if question["expects"] == "feature":  # no earlier question's ring stays on the picture
+            assert page.is_hidden("#picture")
         if question["expects"] == "label":
             page.locator("#answers button").nth(answered % len(question["concepts"])).click()
         elif question["expects"] == "demo":

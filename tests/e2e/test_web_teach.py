@@ -94,13 +94,20 @@ def answer(page, question: dict, truth: Truth, keyboard: bool = False) -> str:
         page.wait_for_function("() => document.getElementById('picture').complete")
         click_picture(page, example[1])
         return "click"
-    labels = page.locator("#features label").all_inner_texts()
+    labels = page.locator("#features label, #features summary").all_text_contents()
     assert labels and not [label for label in labels if re.match(r"\s*\d+(\.\d+)+", label)], labels
-    assert any("its colour" in label for label in labels), labels
+    assert not [label for label in labels if re.search(r"metres|radians|\(0", label)], labels  # no units, scales
+    colour = page.locator("#features summary", has_text="its colour")
+    assert colour.is_hidden()  # folded: the groups first, their details one click away
+    page.locator("#features summary", has_text="how it looks").locator("span").click()
+    assert colour.is_visible() and not page.is_checked("#features input[data-number='1.1']")
     assert "Tick" in question["text"] and "numbers" not in question["text"]
     for number in ("1.1", "1.2", "1.5"):
         page.locator(f"#features input[data-number='{number}']").check()
     page.get_by_role("button", name="use these").click()
+    # the conversation says what was ticked in words, not as "1.1, 1.2, 1.5" (issue 50)
+    page.wait_for_function("() => document.getElementById('conversation').textContent.includes("
+                           "'You: how it looks, its shape and size, how heavy it is')")
     return "button"
 
 

@@ -64,6 +64,8 @@ function handle(message) {
     start3d(message.view);
   } else if (message.type === "nodes") {
     objectNodes = message.nodes;
+  } else if (message.type === "clear") {  // a study's next session: its conversation starts empty
+    $("conversation").replaceChildren();
   }
 }
 
@@ -97,6 +99,7 @@ function showQuestion(asked) {
   if (fresh) { shownAt = performance.now(); }
   $("screen").hidden = true;
   $("ask").hidden = false;
+  document.body.classList.remove("idle");  // the kitchen and the answer controls are for questions
   $("typed").hidden = $("commands").hidden = Boolean(asked.watch);  // a demo: watched, not answered
   showMeta(asked);
   if (asked.seconds_left !== null) { countdown(asked.id, asked.seconds_left); }
@@ -135,6 +138,10 @@ function showQuestion(asked) {
     $("picture").hidden = false;
     $("picture-caption").textContent = asked.expects === "demo"
       ? "Camera picture: click the object you mean." : "Camera picture (the robot's view, numbered).";
+  } else if (!asked.watch) {  // no picture of its own: an earlier question's ring would point at nothing asked now
+    $("picture").hidden = true;
+    $("picture").removeAttribute("src");
+    $("picture-caption").textContent = "This question is not about one object.";
   }
 }
 
@@ -156,11 +163,13 @@ function clearQuestion() {
 }
 
 function featureTree(rows) {
+  // the feature groups in words, folded: the top groups open, every group below them one click away; ticking a
+  // group ticks everything under it (its number is the checkbox's value, never shown)
   const box = document.createElement("div");
   box.id = "features";
+  const parents = [box];  // parents[d]: where a row of depth d goes
   rows.forEach((row) => {
     const label = document.createElement("label");
-    label.style.paddingLeft = `${row.depth * 1.5}em`;
     const check = document.createElement("input");
     check.type = "checkbox";
     check.value = row.number;
@@ -170,9 +179,23 @@ function featureTree(rows) {
         if (other.value.startsWith(row.number + ".")) { other.checked = check.checked; }
       });
     });
-    label.append(check, ` ${row.label}`);  // words, not tree numbers: the number is the checkbox's value
-    if (row.group) { label.style.fontWeight = "600"; }
-    box.appendChild(label);
+    const parent = parents[Math.min(row.depth, parents.length - 1)];
+    if (row.group) {  // its box ticks the group; a click on its words opens it
+      const group = document.createElement("details");
+      group.open = row.depth === 0;
+      const summary = document.createElement("summary");
+      const words = document.createElement("span");
+      words.textContent = ` ${row.label}`;
+      check.setAttribute("aria-label", row.label);
+      summary.append(check, words);
+      group.appendChild(summary);
+      parent.appendChild(group);
+      parents[row.depth + 1] = group;
+      parents.length = row.depth + 2;
+    } else {
+      label.append(check, ` ${row.label}`);
+      parent.appendChild(label);
+    }
   });
   return box;
 }
@@ -199,6 +222,7 @@ function setWaiting(on) {
 
 function showEnded(text) {
   ended = true;
+  document.body.classList.add("idle");  // no kitchen, no answer controls: nothing is asked any more
   setWaiting(false);
   question = null;
   $("screen").hidden = true;
@@ -226,6 +250,7 @@ function showScreen(screen) {
   box.hidden = false;
   box.dataset.title = screen.title;
   $("ask").hidden = true;
+  document.body.classList.add("idle");  // between sessions: no kitchen, no stale picture
   status(screen.title);
   const heading = document.createElement("h2");
   heading.textContent = screen.title;
