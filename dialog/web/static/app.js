@@ -99,7 +99,10 @@ function showQuestion(asked) {
   if (fresh) { shownAt = performance.now(); }
   $("screen").hidden = true;
   $("ask").hidden = false;
-  document.body.classList.remove("idle");  // the kitchen and the answer controls are for questions
+  if (document.body.classList.contains("idle")) {  // the kitchen and the answer controls are for questions
+    document.body.classList.remove("idle");
+    if (viewer) { viewer.set_3d_pane_size(); viewer.needs_render = true; }  // sized while hidden: 0 by 0
+  }
   $("typed").hidden = $("commands").hidden = Boolean(asked.watch);  // a demo: watched, not answered
   showMeta(asked);
   if (asked.seconds_left !== null) { countdown(asked.id, asked.seconds_left); }
