@@ -282,7 +282,7 @@ class ParticipantRun:
                                             observers=observers, lock=lock,
                                             teacher=None if self.page is None else self.page.teacher)
             if self.page is not None and records:  # a resumed session: the page shows the conversation so far
-                self.page.teacher.recall(records, environment.concepts)
+                self.page.teacher.recall(records, environment.concepts, environment.feature_names)
             if person and self.page is None:
                 manager.teacher.reader = self.reader  # one reader for the whole run: nothing typed is lost
                 manager.teacher.show_budget = self.show_conditions

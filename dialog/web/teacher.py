@@ -164,8 +164,14 @@ class WebTeacher:
             question = self.current["id"]
         self._post({"type": "budget", "question": question, "budget_left": budget_left})
 
-    def recall(self, records: list[dict], concepts) -> None:
-        """A resumed session's earlier turns as the page's conversation so far: each question and its answers."""
+    def recall(self, records: list[dict], concepts, feature_names=None) -> None:
+        """A resumed session's earlier turns as the page's conversation so far: each question and its answers (a
+        feature answer in the checkboxes' words, given the session's ``feature_names``)."""
+        labels = {}
+        if feature_names:
+            from dialog.language.feature_tree import FeatureTree
+
+            labels = {row["number"]: row["label"] for row in _tree_rows(FeatureTree(list(feature_names)))}
         for record in records:
             action = record.get("action") or {}
             if action.get("kind") in (None, "none") or not record.get("question"):
@@ -173,7 +179,7 @@ class WebTeacher:
             answer = record.get("answer") or {}
             self._note("robot", words.question_text(action["kind"], record["question"], concepts))
             for line in answer.get("lines") or [answer.get("raw") or ""]:
-                self._note("teacher", line)
+                self._note("teacher", words.answer_words(line, labels) if action["kind"] == "feature" else line)
 
     def researcher(self, text: str) -> None:
         """A line for the researcher only (the strategy, files, the command that continues): the terminal."""

@@ -82,3 +82,11 @@ def test_the_participant_is_you_in_the_pages_session_lines():
     teacher = WebTeacher()
     teacher.say("Turn 3 · the teacher ended the session (quit).", echo=False)
     assert teacher.conversation[-1]["text"] == "Turn 3 · you stopped the session."
+
+
+def test_a_resumed_page_says_an_earlier_feature_answer_in_words():
+    teacher = WebTeacher()
+    teacher.recall([{"turn": 1, "action": {"kind": "feature"}, "question": "Give the numbers...",
+                     "answer": {"lines": ["why", "1.1, 1.2"]}}], ("fruit", "snack"), ["colour.red", "size.height"])
+    assert [line["text"] for line in teacher.conversation if line["who"] == "teacher"] == [
+        "why", "how it looks, its shape and size"]
