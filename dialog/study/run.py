@@ -94,9 +94,8 @@ class ParticipantRun:
         return session_state_of(self.study, self.participant, 0, PRACTICE)
 
     def _refuse_damaged(self, position: int, state) -> None:
-        name = self.name_at(position)
-        raise TranscriptError(f"{self.participant} session {position} ({name}) is damaged, so nothing was written: "
-                              f"{state.reason}")
+        which = "the practice round" if position == 0 else f"session {position} ({self.name_at(position)})"
+        raise TranscriptError(f"{self.participant} {which} is damaged, so nothing was written: {state.reason}")
 
     # -- what to run --------------------------------------------------------------------------------------
     def plan(self, only: str | None, again: bool) -> list[int]:
