@@ -109,6 +109,7 @@ class DialogManager:
         self._test_accuracy: tuple[int, float] | None = None  # (model version, held-out accuracy)
         self._undo_stack: list[tuple] = []
         self.questioner = Questioner(environment, self.state, config.pictures)
+        self._fetched_words = ""  # the last object fetched from the pantry, in words (told to the teacher)
         self.embodied = load_embodied_costs() if config.seconds is not None else None  # dialog/embodied.py
         self._pointing: tuple | None = None  # ((scene id, last pointed), each object's expected pointing seconds)
         self._last_pointed: int | None = None  # the scene object the arm points at now (None: at rest)
@@ -278,7 +279,7 @@ class DialogManager:
             record.update(self._apply(action, outcome, scene))
             message = acknowledgement(prompt, outcome.kind, outcome.value, self.env.feature_names)
             if "fetched" in record:
-                message = f"There's none here, so I fetched one from the pantry ({record['fetched']['kind']})."
+                message = f"There's none here, so I fetched one from the pantry: {self._fetched_words}."
             elif "fetch_failed" in record:
                 message = ("There's none here, and I couldn't fetch one from the pantry: "
                            f"{record['fetch_failed']['reason']}. I'll go on without one.")
@@ -382,6 +383,8 @@ class DialogManager:
                 reason = f"my measurements of it were unusable ({error})"
             else:
                 kept = {key: fetched[key] for key in ("kind", "position", "replaced") if key in fetched}
+                # told in words, as any object (the kind's name is the catalogue's, for the transcript)
+                self._fetched_words = self.questioner.describe_fetched(fetched["x"], fetched.get("position"))
                 return {"fetched": kept}, change
         return {"fetch_failed": {"kind": fetched.get("kind"), "reason": reason}}, self.state.apply(action, None)
 

@@ -281,6 +281,25 @@ NOTE_RULES = [
     ("note a list", replace_text(None, "[1, 2, 3]\n")),
     ("note twice", lambda p, rng: p.write_text(p.read_text() * 2)),
 ]
+CONSENT_RULES = [  # issue 50: d/P01/consent.json, recorded once when P01 agreed (here: simulated)
+    ("given not a way of giving it", set_record(0, ("consent", "given"), ["email", 3, None, "page"])),
+    ("text_sha256 of another text", set_record(0, ("consent", "text_sha256"), ["0" * 64, "", 5])),
+    ("consent of another participant", set_record(0, ("consent", "participant"), ["P02", "P01\n"])),
+    ("time not a time", set_record(0, ("consent", "time"), ["yesterday", 5, None])),
+    ("simulated flipped", set_record(0, ("consent", "simulated"), [False, "yes"])),
+    ("consent unknown field", set_record(0, ("consent", "zz_unknown"), [1])),
+    ("consent a list", replace_text(None, "[1, 2, 3]\n")),
+    ("consent twice", lambda p, rng: p.write_text(p.read_text() * 2)),
+    ("consent removed, the sessions kept", lambda p, rng: p.unlink()),
+]
+PRACTICE_RULES = TRANSCRIPT_RULES + [  # issue 50: d/P01/0-practice.jsonl, the practice round (no questionnaire)
+    ("header strategy of a condition", set_record(0, ("session", "strategy"), ["dt-task", "passive"])),
+    ("header seed edited", set_record(0, ("session", "seed"), [1, 12345])),
+    ("header order of a condition", set_record(0, ("session", "study", "order"), [1, 3, -1])),
+    ("header condition renamed", set_record(0, ("session", "study", "condition"), ["dt-task", "warm-up"])),
+    ("header turns edited", set_record(0, ("session", "turns"), [8, 0])),
+    ("a turn without its answer", drop_field(2, "answer")),
+]
 DEMO_RULES = [
     ("format wrong", lambda p, rng: _edit_json(p, "format", ["x", 3])),
     ("format_version wrong", lambda p, rng: _edit_json(p, "format_version", [99, "2"])),

@@ -64,6 +64,16 @@ class Hostile:
         items = screen.get("items", [])
         answers = ["3" if item["kind"] == "likert" else "fine" for item in items]
         message = {"type": "screen", "screen": screen["id"], "answers": answers}
+        choices = screen.get("choices") or []
+        if choices:  # a screen answered by one of its buttons (the consent): the button's words, no items
+            message["choice"] = choices[0]
+            if self.rng.random() < 0.4:
+                message["choice"] = self.pick([None, 1, "", choices[0].upper(), choices[0] + " ", [choices[0]],
+                                               {"choice": choices[0]}, self.poisoned(choices[0]), "yes"])
+                return "screen choice", json.dumps(message)
+        elif self.rng.random() < 0.1:  # a choice for a screen that has none
+            message["choice"] = self.pick(["I agree", "", None])
+            return "screen choice", json.dumps(message)
         texts = [i for i, item in enumerate(items) if item["kind"] != "likert"]
         scales = [i for i, item in enumerate(items) if item["kind"] == "likert"]
         choice = int(self.rng.integers(8))

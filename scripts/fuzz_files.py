@@ -53,6 +53,7 @@ class Kind:
     recorded: str = ""  # a glob of recorded files whose bytes must survive
     damaged: str = ""  # for study records: the status line that must name the damaged session
     byte_rules: bool = False  # every byte change breaks a rule (an NPZ's SHA-256 is recorded)
+    or_refused: bool = False  # with ``damaged``: a one-line refusal (exit 2) counts too (a study file's own text)
 
 
 def _study(*args):
@@ -94,6 +95,13 @@ def make_kinds(conditions) -> list[Kind]:
              recorded="d/**/*", damaged=f"damaged: P01 session 1 ({conditions[0]})"),
         Kind("study-note", "study", f"{second}-aborted.json", [status, run2], kinds.NOTE_RULES, recorded="d/**/*",
              damaged=f"damaged: P02 session 1 ({conditions[1]})"),
+        Kind("consent-record", "study", "d/P01/consent.json", [status, run1], kinds.CONSENT_RULES,
+             recorded="d/**/*", damaged=f"damaged: P01 session 1 ({conditions[0]})"),
+        Kind("practice-transcript", "study", "d/P01/0-practice.jsonl", [status, run1], kinds.PRACTICE_RULES,
+             recorded="d/**/*", damaged="damaged: P01 practice round"),
+        # the consent text P01 agreed to, changed since: P01's record no longer matches it (or the study is refused)
+        Kind("consent-text", "study", "example-consent.txt", [status, run1], [], recorded="d/**/*",
+             damaged=f"damaged: P01 session 1 ({conditions[0]})", byte_rules=True, or_refused=True),
         Kind("demonstrations", "demos", "d.json", [learn], kinds.DEMO_RULES),
     ]
 
@@ -187,7 +195,7 @@ def bytes_lost(folder: Path, before: dict) -> int:
 def refused(case: Case, kind: Kind | None) -> bool:
     code, output = case.results[0][1], case.results[0][2]
     if kind is not None and kind.damaged:
-        return any(line.startswith(kind.damaged) for line in output.splitlines())
+        return any(line.startswith(kind.damaged) for line in output.splitlines()) or (kind.or_refused and code == 2)
     return code == 2
 
 
@@ -204,6 +212,7 @@ class Fuzzer:
         text = (ROOT / "dialog/data/studies/example.toml").read_text(encoding="utf-8")
         text = re.sub(r"^turns = \d+", "turns = 3", text, flags=re.M).replace("participants = 6 ", "participants = 2 ")
         (base / "study/study.toml").write_text(text, encoding="utf-8")
+        shutil.copy(ROOT / "dialog/data/studies/example-consent.txt", base / "study")
         conditions = re.findall(r'^\[\[conditions\]\]\nname = "([^"]+)"', text, flags=re.M)
         self._must(_study("run", "--participant", "P01", "--simulated"), base / "study")
         self._must(_study("run", "--participant", "P02", "--abort", "fuzz: a note to damage"), base / "study")

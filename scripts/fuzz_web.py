@@ -289,6 +289,8 @@ class Fuzzer:
             message = {"type": "screen", "screen": screen["id"], "answers": [
                 str(int(rng.integers(item["low"], item["high"] + 1))) if item["kind"] == "likert" else "fine"
                 for item in screen.get("items", [])]}
+            if screen.get("choices"):  # the consent: the first button (agree), so that the study goes on
+                message["choice"] = screen["choices"][0]
             self.totals.screens += 1
         elif question["expects"] == "label":
             concept = question["concepts"][int(rng.integers(len(question["concepts"])))]

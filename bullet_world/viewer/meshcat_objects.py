@@ -130,8 +130,10 @@ def _empty_json() -> dict:
 def _sprite_json(look: Look) -> dict:
     data, aspect = text_image(look.text, look.style)
     json = _empty_json()
+    # "screen-text" keeps one size on the screen however far the camera is (a page's number labels: readable
+    # beside the page's text); its height is then a share of the view (three.js multiplies it by the depth)
     material = {"uuid": _uuid(), "type": "SpriteMaterial", "color": 0xFFFFFF, "transparent": True,
-                "depthTest": False, "depthWrite": False, "sizeAttenuation": True,
+                "depthTest": False, "depthWrite": False, "sizeAttenuation": look.shape != "screen-text",
                 "map": _image_texture(data, json)}
     json["materials"].append(material)
     height = look.size[0]
@@ -143,7 +145,7 @@ def _sprite_json(look: Look) -> dict:
 
 def object_jsons(look: Look) -> list[dict]:
     """The three.js object JSON documents (one per geometry) that draw ``look``."""
-    if look.shape == "text":
+    if look.shape in ("text", "screen-text"):
         return [_sprite_json(look)]
     local = np.asarray(look.local, dtype=float).reshape(4, 4)
     result = []

@@ -38,6 +38,9 @@ SHOWN_RGBA = (0.1, 0.75, 0.3, 0.35)
 REGION_RGBA = ((0.9, 0.3, 0.2), (0.2, 0.5, 0.95), (0.55, 0.3, 0.8), (0.95, 0.6, 0.1), (0.2, 0.7, 0.6),
                (0.8, 0.3, 0.6), (0.5, 0.5, 0.5))
 LABEL_HEIGHT_M, TEXT_HEIGHT_M, REGION_LABEL_HEIGHT_M = 0.035, 0.055, 0.028
+# In a page (no text panels: the page has the words) the number and location labels keep one size on the screen,
+# as a share of the 3D view's height: about the page's text (tests/e2e/test_web_labels.py measures them).
+SCREEN_LABEL_HEIGHT, SCREEN_REGION_LABEL_HEIGHT = 0.085, 0.1
 LINE_CHARS, MAX_LINES = 56, 3
 
 
@@ -88,9 +91,10 @@ def _action_fields(action) -> tuple[str, int | None, str | None]:
 
 
 @lru_cache(maxsize=4096)
-def _text(text: str, style: str, height: float) -> tuple[Look, ...]:
-    """The looks of one text sprite (cached: frames are built after every few simulation steps)."""
-    return (Look("text", (height,), (1.0, 1.0, 1.0, 1.0), text=text, style=style),)
+def _text(text: str, style: str, height: float, screen: bool = False) -> tuple[Look, ...]:
+    """The looks of one text sprite (cached: frames are built after every few simulation steps); ``screen``: a
+    constant size on the screen, ``height`` a share of the view's height (``SCREEN_LABEL_HEIGHT``)."""
+    return (Look("screen-text" if screen else "text", (height,), (1.0, 1.0, 1.0, 1.0), text=text, style=style),)
 
 
 @lru_cache(maxsize=1024)
@@ -230,9 +234,14 @@ class Viewer:
             if name not in fixtures:
                 nodes[f"kitchen/locations/{name}"] = ((Look("box", (2 * hx, 2 * hy, 0.003), rgba),),
                                                      translation(cx, cy, z))
-            nodes[f"kitchen/location-names/{name}"] = (_text(name, "location", REGION_LABEL_HEIGHT_M),
+            nodes[f"kitchen/location-names/{name}"] = (self._label(name, "location", REGION_LABEL_HEIGHT_M,
+                                                                   SCREEN_REGION_LABEL_HEIGHT),
                                                        translation(cx, cy + hy - 0.02, z + 0.02))
         return nodes
+
+    def _label(self, text: str, style: str, metres: float, screen: float) -> tuple[Look, ...]:
+        """A label in the scene (``metres`` tall), or in a page (no panels) one of a constant screen size."""
+        return _text(text, style, metres) if self.panels else _text(text, style, screen, True)
 
     def _overlay(self) -> Frame:
         nodes: Frame = {}
@@ -240,7 +249,8 @@ class Viewer:
         for index, (node, (low, high)) in enumerate(zip(self.reader.object_nodes, boxes)):
             style = "label-asked" if index == self.asked else "label-shown" if index == self.shown else "label"
             centre = (low + high) / 2
-            nodes[f"labels/{node.rsplit('/', 1)[-1]}"] = (_text(str(index + 1), style, LABEL_HEIGHT_M),
+            nodes[f"labels/{node.rsplit('/', 1)[-1]}"] = (self._label(str(index + 1), style, LABEL_HEIGHT_M,
+                                                                      SCREEN_LABEL_HEIGHT),
                                                           translation(centre[0], centre[1], high[2] + 0.045))
         for name, index, rgba in (("asked", self.asked, ASKED_RGBA), ("shown", self.shown, SHOWN_RGBA)):
             if index is not None and 0 <= index < len(boxes):

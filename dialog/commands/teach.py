@@ -195,7 +195,7 @@ def _teach(args, settings: SessionSettings, path: Path, lock: TranscriptLock, in
             plain = "This session is already finished."
         _announce(manager, page, intro, plain)
         if page is not None and records:  # the page shows the conversation so far
-            page.teacher.recall(records, environment.concepts)
+            page.teacher.recall(records, environment.concepts, environment.feature_names)
         if person and len(records) < settings.turns and not manager.out_of_time():
             _announce(manager, page, "Type 'help' at any question for what you can answer; 'quit' saves and stops.",
                       "")

@@ -5,6 +5,9 @@ from __future__ import annotations
 import sys
 from dataclasses import dataclass, field
 from pathlib import Path
+from types import SimpleNamespace
+
+import numpy as np
 
 from dialog.environment import KnowsRelevantFeatures, SupportsLocations, SupportsPictures, SupportsViewpoint
 from dialog.language.describe import SceneDescriber
@@ -136,6 +139,18 @@ class Questioner:
         if self._tree is None:
             self._tree = FeatureTree(self.env.feature_names)
         return self._tree
+
+    def describe_fetched(self, x, position) -> str:
+        """An object fetched from the pantry in the words the robot uses for any object ("the red round thing
+        near the pantry"), from what it measured of it (``x``) and where it stood (``position``, x and y)."""
+        row = np.asarray(x, dtype=float).reshape(1, -1)
+        names = tuple(self.env.feature_names)
+        colour = [row[0, names.index(f"colour.{c}")] if f"colour.{c}" in names else 0.0
+                  for c in ("red", "green", "blue")]
+        xy = list(position or (0.0, 0.0))[:2]
+        one = SimpleNamespace(X=row, feature_names=names, n_objects=1, positions=np.array([[*xy, 0.0]]),
+                              colours=np.array([colour]), feature=lambda name: row[:, names.index(name)])
+        return SceneDescriber(one, self.locations, self.viewpoint).describe(0, distinct=False)
 
     def describer(self, scene) -> SceneDescriber:
         if self._describer is None or self._describer.scene is not scene:

@@ -43,8 +43,12 @@ def assigned_orders(study) -> dict[str, tuple[str, ...]]:
 
 
 def session_seed(study, participant: str, condition: str) -> int:
-    """The seed of one participant's session under one condition, derived from the study seed alone."""
+    """The seed of one participant's session under one condition, derived from the study seed alone. The practice
+    round has a seed of its own (spawn key (k,), the conditions' are (k, j)): no condition's seed, and so no
+    condition's transcript, depends on whether the study has a practice round."""
     k = study.participants.index(participant)
+    if condition == "practice" and getattr(study, "practice", None) is not None:
+        return int(np.random.SeedSequence(study.seed, spawn_key=(k,)).generate_state(1)[0])
     j = [c.name for c in study.conditions].index(condition)
     return int(np.random.SeedSequence(study.seed, spawn_key=(k, j)).generate_state(1)[0])
 

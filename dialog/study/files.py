@@ -1,5 +1,8 @@
 """Where a study's records live and what state each session is in, read back from the files alone.
 
+The practice round (a study's ``[practice]``) is the session at position 0 named ``practice``
+(``0-practice.jsonl``), without a questionnaire; the consent record is ``dialog.study.consent``'s.
+
 ``<folder>/<participant>/<order>-<condition>.jsonl`` is the session's transcript (its header carries a
 ``study`` table: study, participant, condition, order, software version);
 ``<order>-<condition>-questionnaire.jsonl`` the answers to the questionnaire after it, and
@@ -138,13 +141,19 @@ def _refuse_unfinished(files: SessionFiles, how: str) -> None:
 
 def session_state_of(study, participant: str, position: int, name: str) -> SessionState:
     """:func:`session_state` of one participant's session at ``position`` (from 1) under condition ``name``."""
+    from dialog.study.consent import consent_problem  # consent records are written with write_atomically
+
     condition = study.condition(name)
     try:
         files = session_files(study, participant, position, name)
     except TeachbotError as error:
         return SessionState("damaged", 0, str(error))
+    problem = consent_problem(study, participant)
+    if problem:  # a damaged or missing consent record: every record of the participant is in doubt
+        return SessionState("damaged", 0, problem)
+    items = () if position == 0 else study.items  # the practice round (position 0) has no questionnaire
     return session_state(files, condition, study_header(study, participant, name, position),
-                         expected_session(study, participant, position, condition), study.items)
+                         expected_session(study, participant, position, condition), items)
 
 
 def write_atomically(path: Path, text: str, what: str, *, replace: bool = True) -> None:

@@ -148,6 +148,7 @@ def report_lines(study, tables, sessions, final, figures) -> list[str]:
              f"{sum(c.state.state == 'done' for c in tables.cells)} of {len(tables.cells)} sessions finished. "
              f"Report by {software_version()}. Tables: `turns.csv` (one row per recorded turn), "
              "`questionnaire.csv` (one row per answer).", ""]
+    lines += opening_report_lines(study)
     simulated, real = tables.simulated_sessions()
     if simulated:
         lines += [f"**{'All' if not real else simulated} of the {simulated + real} recorded sessions "
@@ -181,6 +182,25 @@ def report_lines(study, tables, sessions, final, figures) -> list[str]:
         test_rows += _tests(names, values, item)
     lines += _table(["measure", "conditions", "n", "median difference", "W", "p", "effect r"], test_rows)
     lines += [""] + order_lines(study, tables, final) + [""] + missing_lines(tables)
+    return lines
+
+
+def opening_report_lines(study) -> list[str]:
+    """How many consented and how many practice rounds are recorded: counted, and left out of every table."""
+    from dialog.study.consent import consent_state
+    from dialog.study.files import session_state_of
+
+    lines = []
+    if study.consent is not None:
+        states = [consent_state(study, participant) for participant in study.participants]
+        counts = {state: states.count(state) for state in dict.fromkeys(states)}
+        lines += ["Consent (" + study.consent.file + "): " + ", ".join(f"{n} {state}" for state, n in counts.items())
+                  + ".", ""]
+    if study.practice is not None:
+        states = [session_state_of(study, participant, 0, "practice").state for participant in study.participants]
+        lines += [f"Practice rounds: {states.count('done')} finished, {states.count('running')} unfinished "
+                  f"({study.practice.turns} turns each, `0-practice.jsonl` in a participant's folder); they are "
+                  "left out of every table and test below.", ""]
     return lines
 
 

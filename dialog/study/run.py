@@ -18,7 +18,7 @@ from dialog.environment import SimulatedKitchen
 from dialog.output_paths import check_writable
 from dialog.printed_command import command_line
 from dialog.session import SessionSettings, open_session
-from dialog.study import questionnaire
+from dialog.study import consent, questionnaire
 from dialog.study.design import assigned_orders, questionnaire_rng, session_seed
 from dialog.study.files import (
     read_transcript_checked,
@@ -29,6 +29,7 @@ from dialog.study.files import (
     write_atomically,
 )
 from dialog.study.records import expected_session
+from dialog.study.studyfile import PRACTICE
 from dialog.teachers.terminal import LineReader
 from dialog.transcripts.lock import TranscriptLock
 from dialog.transcripts.records import TEXT_ACCEPTED, text_problem
@@ -84,10 +85,16 @@ class ParticipantRun:
         return [session_state_of(self.study, self.participant, position, name)
                 for position, name in enumerate(self.order, start=1)]
 
+    def name_at(self, position: int) -> str:
+        """The condition at ``position`` (from 1) of the participant's order; 0 is the practice round."""
+        return PRACTICE if position == 0 else self.order[position - 1]
+
+    def practice_state(self):
+        return session_state_of(self.study, self.participant, 0, PRACTICE)
+
     def _refuse_damaged(self, position: int, state) -> None:
-        name = self.order[position - 1]
-        raise TranscriptError(f"{self.participant} session {position} ({name}) is damaged, so nothing was written: "
-                              f"{state.reason}")
+        which = "the practice round" if position == 0 else f"session {position} ({self.name_at(position)})"
+        raise TranscriptError(f"{self.participant} {which} is damaged, so nothing was written: {state.reason}")
 
     # -- what to run --------------------------------------------------------------------------------------
     def plan(self, only: str | None, again: bool) -> list[int]:
@@ -95,8 +102,8 @@ class ParticipantRun:
         states = self.states()
         if only is not None:
             self.study.condition(only)
-            position = self.order.index(only) + 1
-            state = states[position - 1]
+            position = 0 if only == PRACTICE else self.order.index(only) + 1
+            state = self.practice_state() if position == 0 else states[position - 1]
             if state.state == "damaged" and not again:
                 self._refuse_damaged(position, state)
             if state.state in ("done", "aborted") and not again:
@@ -122,6 +129,13 @@ class ParticipantRun:
         for position in todo:
             if states[position - 1].state == "damaged":
                 self._refuse_damaged(position, states[position - 1])
+        if self.study.practice is not None and todo:  # the practice round comes before the first condition
+            practice = self.practice_state()
+            if practice.state == "damaged":
+                self._refuse_damaged(0, practice)
+            if practice.state == "running" or (practice.state == "missing"
+                                               and all(state.state == "missing" for state in states)):
+                todo.insert(0, 0)
         if not todo:
             status = command_line(["study", "status", self.study.path, "--folder", self.study.folder])
             raise TranscriptError(f"{self.participant} has already done every session of study '{self.study.name}' "
@@ -156,10 +170,14 @@ class ParticipantRun:
         positions = self.plan(only, again)
         check_writable(self.study.folder / self.participant, "participant's folder", folder=True)
         order = f" in the order {', '.join(self.order)}" if self.show_conditions else ""
+        practice = " (and the practice round first)" if positions[0] == 0 and len(positions) > 1 else ""
         self.write(f"Study '{self.study.name}', participant {self.participant}: {len(self.order)} sessions{order}; "
-                   f"{len(positions)} to run now.")
+                   f"{len([p for p in positions if p])} to run now{practice}.")
+        agreed = self.ask_consent()
+        if agreed is not True:
+            return agreed
         for count, position in enumerate(positions):
-            if count and not self.simulated:
+            if count and positions[count - 1] and not self.simulated:  # no break after the practice round
                 self.write(f"\n{self.study.pause}")
                 if self.page is not None:
                     self.page.teacher.ask_screen("A short break", self.study.pause, "Go on")
@@ -175,14 +193,15 @@ class ParticipantRun:
 
     def run_one(self, position: int) -> int | None:
         """One session and its questionnaire; None when both are done, else the exit code to stop the run with."""
-        name = self.order[position - 1]
+        name = self.name_at(position)
         condition = self.study.condition(name)
         files = session_files(self.study, self.participant, position, name)
         settings = condition_settings(self.study, self.participant, position, condition, self.simulated)
         state = session_state_of(self.study, self.participant, position, name)
         if state.state == "damaged":
             self._refuse_damaged(position, state)
-        title = f"Session {position} of {len(self.order)}" + (f" ({name})" if self.show_conditions else "")
+        title = "Practice round" if position == 0 else (
+            f"Session {position} of {len(self.order)}" + (f" ({name})" if self.show_conditions else ""))
         self.write(f"\n=== {title} ===")
         if state.state in ("missing", "running"):
             self.write(condition.instructions.strip())
@@ -200,6 +219,8 @@ class ParticipantRun:
             if not finished:
                 self.write(f"Session saved. Continue with: {self.continue_command}")
                 return 130 if finished is None else 0
+        if position == 0:  # the practice round has no questionnaire
+            return None
         if self.study.items and files.questionnaire.exists():
             self.write(f"The questionnaire's answers are already recorded ({files.questionnaire.name}); kept as they "
                        "are.")
@@ -248,6 +269,7 @@ class ParticipantRun:
 
             want_viewer = condition.viewer if self.viewer is None else self.viewer
             if self.page is not None:  # the page shows this session's kitchen (its 3D view unless --no-viewer)
+                self.page.teacher.new_session()  # and only this session's conversation
                 self.page.three_d = self.viewer is not False
                 self.page.attach(environment)
             elif want_viewer and person:
@@ -259,7 +281,7 @@ class ParticipantRun:
                                             observers=observers, lock=lock,
                                             teacher=None if self.page is None else self.page.teacher)
             if self.page is not None and records:  # a resumed session: the page shows the conversation so far
-                self.page.teacher.recall(records, environment.concepts)
+                self.page.teacher.recall(records, environment.concepts, environment.feature_names)
             if person and self.page is None:
                 manager.teacher.reader = self.reader  # one reader for the whole run: nothing typed is lost
                 manager.teacher.show_budget = self.show_conditions
@@ -285,6 +307,45 @@ class ParticipantRun:
             if self.page is not None:
                 self.page.detach()
             environment.close()
+
+    def ask_consent(self) -> bool | int:
+        """The consent text, before anything is recorded: True once agreed (now or in an earlier run), else the
+        exit code to stop with (0: declined, with only the declined note recorded; 1: no answer could be read)."""
+        study, participant = self.study, self.participant
+        if study.consent is None or consent.consent_path(study, participant).exists():
+            return True  # agreed once (a damaged record was refused with the sessions it marks damaged)
+        check_writable(consent.consent_path(study, participant), "consent record")
+        if self.simulated:
+            consent.record_agreed(study, participant, "simulated")
+            self.write("Consent: not asked in a simulated run; the consent record says simulated.")
+            return True
+        if self.page is not None:
+            choice = self.page.teacher.ask_choice("Before we begin", study.consent.text.strip() + "\n"
+                                                  + consent.QUESTION, (consent.AGREE, consent.DECLINE))
+            agreed = choice == consent.AGREE
+        else:
+            self.write("\n" + study.consent.text.strip() + f"\n\n{consent.QUESTION} Type 'yes' or 'no'.")
+            agreed = None
+            while agreed is None:
+                self.write("> ", end="")
+                line = self.read_line()
+                if line is None:
+                    self.write("\nNo answer to the consent question (standard input ended): nothing was recorded. "
+                               "Run study run where the participant can answer (at a terminal, or with --web).")
+                    return 1
+                agreed = {"yes": True, "y": True, "no": False, "n": False}.get(line.strip().lower())
+                if agreed is None:
+                    self.write("Please type 'yes' to take part or 'no' not to.")
+        if not agreed:
+            path = consent.record_declined(study, participant)
+            self.write(f"{participant} did not agree to take part: nothing is recorded but the note {path.name}; "
+                       "the run ends.")
+            if self.page is not None:
+                self.page.teacher.end("You chose not to take part. Nothing was recorded. Thank you for your time.")
+            return 0
+        path = consent.record_agreed(study, participant, "page" if self.page is not None else "terminal")
+        self.write(f"Consent recorded ({path.name}).")
+        return True
 
     def _narrator(self, teacher, person: bool):
         def say(text: str) -> None:

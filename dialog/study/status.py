@@ -44,6 +44,33 @@ def completed_orders(study, cells: list[Cell]) -> list[tuple[str, ...]]:
     return [orders[participant] for participant, flags in done.items() if all(flags)]
 
 
+def opening_lines(study) -> list[str]:
+    """Consent and the practice round, one line each over the participants (nothing when the study has neither)."""
+    from dialog.study.consent import consent_state
+
+    lines = []
+    if study.consent is not None:
+        states = {participant: consent_state(study, participant) for participant in study.participants}
+        lines.append(f"consent ({study.consent.file}): " + _tally(states))
+    if study.practice is not None:
+        states = {participant: _shown(session_state_of(study, participant, 0, "practice"), study.practice.turns)
+                  for participant in study.participants}
+        lines.append("practice round (not in the report's tables): " + _tally(states))
+        for participant in study.participants:
+            state = session_state_of(study, participant, 0, "practice")
+            if state.state == "damaged":
+                lines.append(f"damaged: {participant} practice round: {state.reason}")
+    return lines
+
+
+def _tally(states: dict[str, str]) -> str:
+    """"P01 agreed, P02 agreed, P03 not asked yet" as "agreed: P01, P02; not asked yet: P03"."""
+    groups: dict[str, list[str]] = {}
+    for participant, state in states.items():
+        groups.setdefault(state, []).append(participant)
+    return "; ".join(f"{state}: {', '.join(names)}" for state, names in groups.items())
+
+
 def status_text(study) -> str:
     """One line per participant ("dt-task: done" per session, in their order), then the counts and the balance."""
     cells = study_cells(study)
@@ -57,6 +84,7 @@ def status_text(study) -> str:
         by_participant.setdefault(cell.participant, []).append(cell)
     for participant, row in by_participant.items():
         lines.append((f"{participant:<13}" + "".join(f"{shown[id(c)]:<{width}}" for c in row)).rstrip())
+    lines += opening_lines(study)
     counts = {state: sum(c.state.state == state for c in cells) for state in
               ("done", "running", "questionnaire", "aborted", "damaged", "missing")}
     lines.append("sessions: " + ", ".join(f"{count} {state}" for state, count in counts.items()))

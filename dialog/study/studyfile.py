@@ -9,6 +9,7 @@ of ``learning.datafiles.check_name`` (a full match: no separators, no leading do
 
 from __future__ import annotations
 
+import hashlib
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -25,6 +26,10 @@ ORDERINGS = ("latin", "given")
 ITEM_KINDS = ("likert", "text")
 CONDITION_FIELDS = ("name", "instructions", "task", "kitchen", "strategy", "budget", "turns", "change_every",
                     "realtime", "costs", "viewer", "fetch_from_pantry")
+PRACTICE = "practice"  # the practice round's name: its files are 0-practice.*; no condition may take it
+PRACTICE_FIELDS = tuple(name for name in CONDITION_FIELDS if name != "name")
+PRACTICE_TURNS = 10  # a practice round is a few turns
+CONSENT_BYTES = 100_000
 
 
 def check_participant_id(value, where: str = "participant") -> str:
@@ -62,6 +67,15 @@ class Item:
 
 
 @dataclass(frozen=True)
+class Consent:
+    """The consent text (a file beside the study file) and the SHA-256 of its bytes, which the record keeps."""
+
+    file: str
+    text: str
+    sha256: str
+
+
+@dataclass(frozen=True)
 class Study:
     path: Path
     name: str
@@ -75,13 +89,19 @@ class Study:
     simulated_teacher: dict
     pause: str
     simulated: bool = False  # a dry run (study run --simulated): every record it writes says so
+    consent: Consent | None = None  # the informed-consent text shown before anything else
+    practice: Condition | None = None  # a few turns before the conditions, recorded apart (named "practice")
 
     def condition(self, name: str) -> Condition:
+        """A condition by name; ``practice`` is the practice round, when the study has one."""
+        if name == PRACTICE and self.practice is not None:
+            return self.practice
         for condition in self.conditions:
             if condition.name == name:
                 return condition
+        practice = " (and 'practice', the practice round)" if self.practice is not None else ""
         raise DataFileError(f"{self.path}: no condition '{name}'; the conditions are "
-                            f"{', '.join(c.name for c in self.conditions)}")
+                            f"{', '.join(c.name for c in self.conditions)}{practice}")
 
     def check_participant(self, participant: str) -> str:
         check_participant_id(participant)
@@ -98,7 +118,7 @@ def load_study(path: str | Path) -> Study:
     where = str(path)
     df.check_keys(data, where, required=("name", "seed", "conditions"),
                   optional=("folder", "participants", "ids", "order", "orders", "pause", "simulated_teacher",
-                            "questionnaire"))
+                            "questionnaire", "consent", "practice"))
     name = df.name(data, "name", where, what="study name")
     seed = df.integer(data, "seed", where, low=0)
     conditions = tuple(_condition(table, f"{where} [[conditions]] {index + 1}")
@@ -108,6 +128,9 @@ def load_study(path: str | Path) -> Study:
         raise DataFileError(f"{where}: condition names must differ, got {names}")
     if len(conditions) > 8:
         raise DataFileError(f"{where}: at most 8 conditions, got {len(conditions)}")
+    if PRACTICE in names:
+        raise DataFileError(f"{where}: [[conditions]] name 'practice' is taken by the practice round; accepted: "
+                            "any other name (the practice round is a [practice] table)")
     participants = _participants(data, where)
     ordering = df.text(data, "order", where, default="latin", choices=ORDERINGS)
     given = _given_orders(data, where, ordering, participants, names)
@@ -121,7 +144,51 @@ def load_study(path: str | Path) -> Study:
                                 high=None if key == "answer_delay" else 1) for key in teacher}
     folder = Path(df.text(data, "folder", where, default=f"runs/studies/{name}"))
     pause = df.text(data, "pause", where, default="Take a short break. Press Enter when you are ready to go on.")
-    return Study(path, name, seed, folder, conditions, participants, ordering, given, items, simulated, pause)
+    consent = _consent(path, data, where) if "consent" in data else None
+    practice = _practice(df.section(data, "practice", where), f"{where} [practice]") if "practice" in data else None
+    return Study(path, name, seed, folder, conditions, participants, ordering, given, items, simulated, pause,
+                 consent=consent, practice=practice)
+
+
+def _consent(path: Path, data: dict, where: str) -> Consent:
+    """``consent = "FILE"``: a UTF-8 text file in the study file's folder, read now (its SHA-256 is recorded)."""
+    from dialog.transcripts.records import TEXT_ACCEPTED, text_problem
+
+    name = df.check_name(data["consent"], "'consent'", where)
+    file = path.parent / name
+    accepted = (f"accepted: the name of a UTF-8 text file of at most {CONSENT_BYTES} bytes beside the study file, "
+                "such as consent.md")
+    if not file.is_file():
+        raise DataFileError(f"{where}: 'consent' names {file}, which is {'not a file' if file.exists() else 'missing'}"
+                            f"; {accepted}")
+    try:
+        raw = file.read_bytes()
+    except OSError as error:
+        raise DataFileError(f"{where}: 'consent' {file} can't be read ({error.strerror or error}); {accepted}") \
+            from None
+    if len(raw) > CONSENT_BYTES:
+        raise DataFileError(f"{where}: 'consent' {file} has {len(raw)} bytes; {accepted}")
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as error:
+        raise DataFileError(f"{where}: 'consent' {file} is not UTF-8 text (byte {error.start}); {accepted}") from None
+    problem = text_problem(text, "\t\n\r")
+    if not text.strip() or problem:
+        raise DataFileError(f"{where}: 'consent' {file} " + (f"holds text that is not plain ({problem})" if problem
+                            else "is empty") + f"; {accepted} holding {TEXT_ACCEPTED}")
+    return Consent(name, text, hashlib.sha256(raw).hexdigest())
+
+
+def _practice(table: dict, where: str) -> Condition:
+    """``[practice]``: a condition's fields but its name; a few turns (its records are left out of the report)."""
+    df.check_keys(table, where, required=("strategy",), optional=PRACTICE_FIELDS)
+    turns = df.integer(table, "turns", where, default=3, low=1, high=PRACTICE_TURNS)
+    return _condition({**table, "name": PRACTICE, "turns": turns,
+                       "instructions": df.text(table, "instructions", where, default=PRACTICE_INSTRUCTIONS)}, where)
+
+
+PRACTICE_INSTRUCTIONS = ("A short practice round first, to try how answering works: nothing you answer here is "
+                         "studied.")
 
 
 def _condition(table: dict, where: str) -> Condition:

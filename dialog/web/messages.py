@@ -171,13 +171,21 @@ FREE_TEXT_CONTROLS = "\t\n\r"  # the control characters a text box may hold
 
 def read_screen(message: dict, screen: dict | None) -> list:
     """The values a study screen's form gave (None: an item left out), checked against the open ``screen``."""
-    unknown = sorted(set(message) - {"type", "screen", "answers"})
+    choices = screen.get("choices") if screen is not None else None
+    fields = {"type", "screen", "answers"} | ({"choice"} if choices else set())
+    unknown = sorted(set(message) - fields)
     if unknown:
-        raise MessageError(f"unknown fields {', '.join(map(_shown, unknown))} in a screen message; accepted: type, "
-                           "screen, answers")
+        raise MessageError(f"unknown fields {', '.join(map(_shown, unknown))} in a screen message; accepted: "
+                           f"{', '.join(sorted(fields))}")
     if screen is None or not _is_whole(message.get("screen")) or message.get("screen") != screen["id"]:
         raise MessageError(f"an answer to screen {_shown(message.get('screen'))}; accepted: answers to the screen "
                            "shown")
+    if choices:  # a screen answered by one of its buttons (the consent): that button's words, and no items
+        if message.get("choice") not in choices or message.get("answers") != []:
+            raise MessageError(f"screen choice {_shown(message.get('choice'))} with answers "
+                               f"{_shown(message.get('answers'))}; accepted: one of {', '.join(choices)}, with "
+                               "answers []")
+        return [message["choice"]]
     items, answers = screen.get("items", []), message.get("answers")
     if not (isinstance(answers, list) and len(answers) == len(items) and all(isinstance(a, str) for a in answers)):
         raise MessageError(f"screen answers {_shown(answers)}; accepted: one text per item ({len(items)})")

@@ -34,7 +34,8 @@ import tornado.websocket
 from learning.errors import SettingsError, SetupError
 
 STATIC = Path(__file__).with_name("static")
-ASSETS = {"app.js": "application/javascript", "diffuse.js": "application/javascript", "style.css": "text/css"}
+ASSETS = {"app.js": "application/javascript", "forms.js": "application/javascript",
+          "diffuse.js": "application/javascript", "style.css": "text/css"}
 WEBSOCKET_LIMIT_BYTES = 1 << 16
 LOOPBACK = "127.0.0.1"
 SECURITY_HEADERS = {

@@ -55,6 +55,7 @@ class WebTeacher:
         self.show_budget = True  # a study hides it from its participants
         self._screen: dict | None = None  # an open study screen (instructions, pause, questionnaire)
         self._screen_answers: queue.Queue[list] = queue.Queue()
+        self._labels: dict[str, str] = {}  # the open feature question's checkbox words, by tree number
 
     def options(self) -> dict:
         return {"kind": "terminal"}
@@ -89,6 +90,8 @@ class WebTeacher:
             n_objects = int(getattr(prompt.scene, "n_objects", 0))
             self._asked = Asked(self._question, prompt.expects, tuple(prompt.concepts), n_objects, numbers)
             self._pixels = self.locate(prompt.scene) if self.locate is not None and prompt.picture else None
+            rows = _tree_rows(tree) if tree is not None else []
+            self._labels = {row["number"]: row["label"] for row in rows}
             if prompt.picture:
                 self.pictures[self._question] = prompt.picture
             self.current = {
@@ -99,7 +102,7 @@ class WebTeacher:
                 "object": None if prompt.object_index is None else prompt.object_index + 1,
                 "picture": bool(prompt.picture), "details": [line for line in prompt.details
                                                              if not line.startswith("Picture:")],
-                "features": _tree_rows(tree) if tree is not None else [],
+                "features": rows,
                 "seconds_left": None if prompt.deadline is None or self.clock is None
                 else round(max(0.0, prompt.deadline - self.clock.now()), 1),
                 "help": words.help_text(prompt),
@@ -123,7 +126,8 @@ class WebTeacher:
                 except queue.Empty:
                     continue
                 self._last = answer
-                self._note("teacher", answer.line)
+                shown = words.answer_words(answer.line, self._labels) if prompt.expects == "feature" else answer.line
+                self._note("teacher", shown)  # in words: what was ticked, not its tree numbers
                 return answer.line
         finally:
             with self._lock:
@@ -160,8 +164,14 @@ class WebTeacher:
             question = self.current["id"]
         self._post({"type": "budget", "question": question, "budget_left": budget_left})
 
-    def recall(self, records: list[dict], concepts) -> None:
-        """A resumed session's earlier turns as the page's conversation so far: each question and its answers."""
+    def recall(self, records: list[dict], concepts, feature_names=None) -> None:
+        """A resumed session's earlier turns as the page's conversation so far: each question and its answers (a
+        feature answer in the checkboxes' words, given the session's ``feature_names``)."""
+        labels = {}
+        if feature_names:
+            from dialog.language.feature_tree import FeatureTree
+
+            labels = {row["number"]: row["label"] for row in _tree_rows(FeatureTree(list(feature_names)))}
         for record in records:
             action = record.get("action") or {}
             if action.get("kind") in (None, "none") or not record.get("question"):
@@ -169,7 +179,7 @@ class WebTeacher:
             answer = record.get("answer") or {}
             self._note("robot", words.question_text(action["kind"], record["question"], concepts))
             for line in answer.get("lines") or [answer.get("raw") or ""]:
-                self._note("teacher", line)
+                self._note("teacher", words.answer_words(line, labels) if action["kind"] == "feature" else line)
 
     def researcher(self, text: str) -> None:
         """A line for the researcher only (the strategy, files, the command that continues): the terminal."""
@@ -191,7 +201,14 @@ class WebTeacher:
         (a line the terminal gets from elsewhere)."""
         if echo and self.echo is not None:
             print(text, file=self.echo, flush=True)
-        self._note("session", text.strip())
+        self._note("session", words.for_participant(text.strip()))
+
+    def new_session(self) -> None:
+        """A study's next session: the page's conversation starts empty (the transcripts keep every line)."""
+        with self._lock:
+            self.conversation.clear()
+            self.current, self._asked, self._shown = None, None, None
+        self._post({"type": "clear"})
 
     def new_view(self, available: bool) -> None:
         """A new 3D view (another kitchen's meshcat mirror) for the page to connect to."""
@@ -232,6 +249,22 @@ class WebTeacher:
         while True:
             try:
                 return self._screen_answers.get(timeout=POLL_S)
+            except queue.Empty:
+                continue
+
+    def ask_choice(self, title: str, text: str, choices: tuple[str, ...]) -> str:
+        """Show a study screen that ends with one of ``choices`` (a button each; the consent's "I agree" and "I do
+        not agree") and wait for the one pressed."""
+        with self._lock:
+            self._question += 1
+            self._screen = {"id": self._question, "title": title, "text": text, "button": "", "items": [],
+                            "choices": list(choices)}
+            self.current, self._asked = None, None
+            screen = dict(self._screen)
+        self._post({"type": "screen", "screen": screen})
+        while True:
+            try:
+                return self._screen_answers.get(timeout=POLL_S)[0]
             except queue.Empty:
                 continue
 
@@ -287,7 +320,8 @@ def _tree_rows(tree) -> list[dict]:
             group = node.feature is None
             here = f"{path}/{node.name}" if path else node.name
             rows.append({"number": node.number, "name": node.name,
-                         "label": words.group_label(here) if group else node.description or node.name,
+                         "label": words.group_label(here) if group
+                         else words.plain_feature(node.name, node.description or node.name),
                          "depth": depth, "group": group})
             walk(node.children, depth + 1, here)
 

@@ -13,6 +13,7 @@ from pathlib import Path
 
 from dialog.language.questions import Prompt
 from learning.datafiles import read_toml, section
+from learning.errors import DataFileError
 
 GROUP_WORDS = Path(__file__).resolve().parents[1] / "data" / "feature-groups.toml"
 COMMANDS_HELP = ("\"Why?\" asks my reason for the question, \"Undo\" takes back your last answer, \"Skip\" leaves "
@@ -25,6 +26,51 @@ def group_words() -> dict[str, str]:
     """Each feature group's path ("object/appearance/colour") in plain words ("its colour")."""
     table = section(read_toml(GROUP_WORDS, "feature group words"), "groups", str(GROUP_WORDS))
     return {str(path): str(words) for path, words in table.items()}
+
+
+@lru_cache(maxsize=1)
+def plain_rules() -> tuple[list[tuple[re.Pattern, str]], dict[str, str]]:
+    """The patterns that take a feature description's units and scales out, and whole descriptions by name."""
+    where = str(GROUP_WORDS)
+    plain = section(read_toml(GROUP_WORDS, "feature group words"), "plain", where)
+    rules = []
+    for pair in plain.get("patterns", []):
+        if not (isinstance(pair, list) and len(pair) == 2 and all(isinstance(part, str) for part in pair)):
+            raise DataFileError(f"{where}: [plain] patterns holds {pair!r}; accepted: [\"regular expression\", "
+                                "\"replacement\"] pairs")
+        try:
+            rules.append((re.compile(pair[0]), pair[1]))
+        except re.error as error:
+            raise DataFileError(f"{where}: [plain] pattern {pair[0]!r} is not a regular expression ({error})") \
+                from None
+    features = section(plain, "features", f"{where} [plain]", default={})
+    return rules, {str(name): str(text) for name, text in features.items()}
+
+
+def plain_feature(name: str, description: str) -> str:
+    """A feature's description without the units and scales a participant need not know."""
+    rules, whole = plain_rules()
+    if name in whole:
+        return whole[name]
+    for pattern, replacement in rules:
+        description = pattern.sub(replacement, description)
+    return description
+
+
+def answer_words(line: str, labels: dict[str, str]) -> str:
+    """A feature answer from the checkboxes ("1.1, 1.2", "ignore 2") in the boxes' words ("how it looks, its
+    shape and size"; "these don't matter: ..."); any other line as it is."""
+    found = re.fullmatch(r"(ignore )?((?:\d+(?:\.\d+)*)(?:, \d+(?:\.\d+)*)*)", line.strip())
+    numbers = found.group(2).split(", ") if found else []
+    if not numbers or any(number not in labels for number in numbers):
+        return line
+    said = ", ".join(labels[number] for number in numbers)
+    return f"these don't matter: {said}" if found.group(1) else said
+
+
+def for_participant(text: str) -> str:
+    """A session line about the person at the page said to them: "you stopped", not "the teacher ended"."""
+    return re.sub(r"the teacher ended the session \([^)]*\)", "you stopped the session", text)
 
 
 def group_label(path: str) -> str:

@@ -3,6 +3,8 @@ study texts name the page's buttons, a resumed page gets the conversation so far
 
 from __future__ import annotations
 
+import re
+
 from bullet_world.features import feature_catalogue
 from dialog.language.feature_tree import FeatureTree
 from dialog.web import words
@@ -56,3 +58,35 @@ def test_an_undo_gives_the_budget_back_on_the_page_at_once():
     teacher.show_budget = False  # a study hides the budget from its participants
     teacher.budget_changed(36.0)
     assert len(sent) == 1
+
+
+def test_a_feature_answer_from_the_checkboxes_is_shown_in_their_words():
+    rows = {row["number"]: row["label"] for row in _tree_rows(FeatureTree(["colour.red", "size.height"]))}
+    assert words.answer_words("1.1, 1.2", rows) == "how it looks, its shape and size"
+    assert words.answer_words("ignore 1.1", rows) == "these don't matter: how it looks"
+    assert words.answer_words("fruit", rows) == "fruit" and words.answer_words("9.9", rows) == "9.9"
+
+
+def test_feature_descriptions_lose_their_units_and_scales():
+    from bullet_world.features import feature_catalogue
+
+    shown = {info.name: words.plain_feature(info.name, info.description) for info in feature_catalogue()}
+    for name, text in shown.items():
+        assert not re.search(r"metres|radians|kilograms|decibels|quaternion|\(\s*[-+0-9]|\d\.\d", text), (name, text)
+        assert text.strip() and text[0].isupper(), (name, text)
+    assert shown["colour.red"] == "How red the object looks on average"
+    assert len(set(shown.values())) == len(shown)  # no two checkboxes read the same
+
+
+def test_the_participant_is_you_in_the_pages_session_lines():
+    teacher = WebTeacher()
+    teacher.say("Turn 3 · the teacher ended the session (quit).", echo=False)
+    assert teacher.conversation[-1]["text"] == "Turn 3 · you stopped the session."
+
+
+def test_a_resumed_page_says_an_earlier_feature_answer_in_words():
+    teacher = WebTeacher()
+    teacher.recall([{"turn": 1, "action": {"kind": "feature"}, "question": "Give the numbers...",
+                     "answer": {"lines": ["why", "1.1, 1.2"]}}], ("fruit", "snack"), ["colour.red", "size.height"])
+    assert [line["text"] for line in teacher.conversation if line["who"] == "teacher"] == [
+        "why", "how it looks, its shape and size"]

@@ -34,6 +34,10 @@ def test_saying_none_to_show_me_questions_keeps_the_session_going_and_resumable(
     _, records = read_session(path)
     absent = [r for r in records if r["action"]["kind"] == "demo" and "fetched" in r]
     assert len(absent) >= 2  # every "none" to a "show me" question brought an example from the pantry
+    # told in words, as the robot describes any object, never by the catalogue's kind name (issue 50)
+    told = [line for line in out.splitlines() if "so I fetched one from the pantry" in line]
+    assert len(told) == len(absent) and all(": the " in line for line in told), told
+    assert not any(record["fetched"]["kind"] in line for record in absent for line in told), told
 
     # "none" answers a show-me question, "fruit" a label question (re-asked after the "none"): the resumed
     # session goes on whichever it asks (which one can turn on a tie between two equally good demos)

@@ -70,7 +70,8 @@ def test_a_small_run_covers_every_kind_and_finds_nothing_in_the_file_and_path_re
     assert small_run["cases"] == 26 and set(COUNTS) <= set(small_run)
     assert sorted(small_run["per_kind"]) == sorted(
         ["study", "suite", "weights", "policy", "policy-npz", "kitchen", "task", "transcript", "replay",
-         "study-transcript", "questionnaire", "study-note", "demonstrations", "paths"])
+         "study-transcript", "questionnaire", "study-note", "consent-record", "practice-transcript", "consent-text",
+         "demonstrations", "paths"])
     found = {kind: {name: counts[name] for name in COUNTS if counts[name]}
              for kind, counts in small_run["per_kind"].items() if kind not in OTHER_AREAS}
     assert not any(found.values()), (found, small_run["examples"])
@@ -95,9 +96,11 @@ def test_the_same_seed_mutates_the_same_files_the_same_way(tmp_path):
 
 
 def _content(path: Path):
-    """A mutated file's bytes; a link's target and a FIFO by kind (reading a FIFO would block)."""
+    """A mutated file's bytes; a link's target, a FIFO and a removed file by kind (reading a FIFO would block)."""
     if path.is_symlink():
         return ("link", os.readlink(path))
+    if not path.exists():  # a record removed (the consent record, its sessions kept)
+        return ("missing",)
     return ("fifo",) if stat.S_ISFIFO(path.stat().st_mode) else path.read_bytes()
 
 

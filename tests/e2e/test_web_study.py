@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import csv
 import dataclasses
+import json
 import subprocess
 from pathlib import Path
 
@@ -35,28 +36,38 @@ def click_through(page, titles: list[str], seen: dict | None = None) -> int:
     """Answer every screen and question by clicking until the run ends; returns the questions answered. Each
     screen's visible text is checked for the researcher's words (``seen``: each kind of screen's last text)."""
     answered, seen = 0, {} if seen is None else seen
+    fresh = False  # the first question of a session is next
     while True:
         page.wait_for_function(READY, timeout=120_000)
         if page.evaluate("() => ended"):
             check_screen(page, "end", seen)
+            assert page.is_hidden("#views") and page.is_hidden("#commands") and page.is_hidden("#typed")
             return answered
         if not page.locator("#screen").is_hidden():
+            # between sessions: no kitchen, no stale picture, no greyed answer controls (issue 50)
+            assert page.is_hidden("#views") and page.is_hidden("#ask")
             titles.append(page.inner_text("#screen h2"))
-            kind = {"A short break": "pause", "A few questions about this session": "questionnaire"}.get(
-                titles[-1], "instructions")
+            fresh = titles[-1].startswith(("Session", "Practice"))
+            kind = {"A short break": "pause", "A few questions about this session": "questionnaire",
+                    "Before we begin": "consent"}.get(titles[-1], "instructions")
             check_screen(page, kind, seen)
             seen[f"{kind}: {titles[-1]}"] = seen[kind]
             assert page.inner_text("#status") == titles[-1]  # the header says what the screen is
-            button = page.inner_text("#screen form > button")
+            button = page.locator("#screen form > button").first.inner_text()  # the consent's: "I agree"
             assert "Press Enter" not in seen[kind] and ("Press" not in seen[kind] or f'"{button}"' in seen[kind])
             for group in page.locator("#screen fieldset").all():
                 radios = group.locator("input[type=radio]")
                 if radios.count():
                     radios.nth(radios.count() - 2).check()  # one below the top of the scale
-            page.locator("#screen form > button").click()
+            page.locator("#screen form > button").first.click()
             continue
         question = page.evaluate("() => question")
         check_screen(page, f"{question['expects']} question", seen)
+        if fresh:  # a new session's conversation starts empty: nothing answered yet (the transcript keeps all)
+            assert "You: " not in page.inner_text("#conversation"), page.inner_text("#conversation")
+            fresh = False
+        if question["expects"] == "feature":  # no earlier question's ring stays on the picture
+            assert page.is_hidden("#picture")
         if question["expects"] == "label":
             page.locator("#answers button").nth(answered % len(question["concepts"])).click()
         elif question["expects"] == "demo":
@@ -83,11 +94,13 @@ def test_a_participant_does_the_example_study_in_the_browser_with_clicks_only(tm
         command.stop()
     study = load_study(EXAMPLE)
     shown = "".join(command.out) + "".join(titles)
-    assert titles[0] == "Session 1 of 3" and "Session 3 of 3" in titles
+    assert titles[:3] == ["Before we begin", "Practice round", "Session 1 of 3"] and "Session 3 of 3" in titles
+    assert "A short break" not in titles[:3]  # no break after the practice round
     assert not any(condition.name in title for condition in study.conditions for title in titles)
     assert "budget" not in shown.lower()
     assert answered >= 3
-    assert {"instructions", "label question", "questionnaire", "pause", "end"} <= set(seen), sorted(seen)
+    assert {"consent", "instructions", "label question", "questionnaire", "pause", "end"} <= set(seen), sorted(seen)
+    assert "Do you agree to take part?" in seen["consent"]
     assert 'Press "Go on"' in seen["pause"]
     assert any('press "Why?"' in text for key, text in seen.items() if key.startswith("instructions: "))
 
@@ -100,6 +113,9 @@ def test_a_participant_does_the_example_study_in_the_browser_with_clicks_only(tm
         asked = [r for r in records if r["action"]["kind"] != "none"]
         assert all(set(r["answer"]["channels"]) <= {"button", "click"} for r in asked)
         assert files.questionnaire.exists()
+    person = folder / "P01"
+    assert json.loads((person / "consent.json").read_text())["consent"]["given"] == "page"
+    assert len(read_session(person / "0-practice.jsonl")[1]) == study.practice.turns
 
     status = subprocess.run([TEACHBOT, "study", "status", EXAMPLE, "--folder", folder], capture_output=True,
                             text=True, timeout=120)

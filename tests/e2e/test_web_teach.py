@@ -95,13 +95,20 @@ def answer(page, question: dict, truth: Truth, keyboard: bool = False) -> str:
         page.wait_for_function("() => document.getElementById('picture').complete")
         click_picture(page, example[1])
         return "click"
-    labels = page.locator("#features label").all_inner_texts()
+    labels = page.locator("#features label, #features summary").all_text_contents()
     assert labels and not [label for label in labels if re.match(r"\s*\d+(\.\d+)+", label)], labels
-    assert any("its colour" in label for label in labels), labels
+    assert not [label for label in labels if re.search(r"metres|radians|\(0", label)], labels  # no units, scales
+    colour = page.locator("#features summary", has_text="its colour")
+    assert colour.is_hidden()  # folded: the groups first, their details one click away
+    page.locator("#features summary", has_text="how it looks").locator("span").click()
+    assert colour.is_visible() and not page.is_checked("#features input[data-number='1.1']")
     assert "Tick" in question["text"] and "numbers" not in question["text"]
     for number in ("1.1", "1.2", "1.5"):
         page.locator(f"#features input[data-number='{number}']").check()
     page.get_by_role("button", name="use these").click()
+    # the conversation says what was ticked in words, not as "1.1, 1.2, 1.5" (issue 50)
+    page.wait_for_function("() => document.getElementById('conversation').textContent.includes("
+                           "'You: how it looks, its shape and size, how heavy it is')")
     return "button"
 
 
@@ -198,7 +205,19 @@ def test_a_whole_session_in_the_browser_equals_the_same_answers_typed(tmp_path):
                     channels.append(answer(page, question, truth, keyboard=question["turn"] == 1))
                     done_turns += 1
                     question = wait_for_question(page, after=question["id"])
+                # a stray key cannot end it (issue 50): a click on the page background, then q, asks first
+                page.mouse.click(5, page.viewport_size["height"] - 5)
+                page.keyboard.press("q")
+                assert page.is_visible("#confirm") and "Stop this session?" in page.inner_text("#confirm")
+                assert page.evaluate("() => document.activeElement.id") == "confirm-go-on"  # the default
+                page.keyboard.press("Enter")  # Go on
+                assert page.is_hidden("#confirm") and page.evaluate("() => waiting && !ended")
+                page.keyboard.press("q")
+                page.keyboard.press("Escape")  # Go on, too
+                assert page.is_hidden("#confirm") and page.evaluate("() => waiting && !ended")
+                assert page.evaluate("() => question.id") == question["id"]
                 page.get_by_role("button", name="Quit").click()
+                page.keyboard.press("y")  # meant: the session ends as before
                 page.wait_for_function("() => ended")
                 assert "saved after 5 of 8 turns" in check_screen(page, "quit", seen, (why,))
                 assert first.finish() == 0

@@ -64,6 +64,8 @@ function handle(message) {
     start3d(message.view);
   } else if (message.type === "nodes") {
     objectNodes = message.nodes;
+  } else if (message.type === "clear") {  // a study's next session: its conversation starts empty
+    $("conversation").replaceChildren();
   }
 }
 
@@ -97,6 +99,10 @@ function showQuestion(asked) {
   if (fresh) { shownAt = performance.now(); }
   $("screen").hidden = true;
   $("ask").hidden = false;
+  if (document.body.classList.contains("idle")) {  // the kitchen and the answer controls are for questions
+    document.body.classList.remove("idle");
+    if (viewer) { viewer.set_3d_pane_size(); viewer.needs_render = true; }  // sized while hidden: 0 by 0
+  }
   $("typed").hidden = $("commands").hidden = Boolean(asked.watch);  // a demo: watched, not answered
   showMeta(asked);
   if (asked.seconds_left !== null) { countdown(asked.id, asked.seconds_left); }
@@ -135,6 +141,10 @@ function showQuestion(asked) {
     $("picture").hidden = false;
     $("picture-caption").textContent = asked.expects === "demo"
       ? "Camera picture: click the object you mean." : "Camera picture (the robot's view, numbered).";
+  } else if (!asked.watch) {  // no picture of its own: an earlier question's ring would point at nothing asked now
+    $("picture").hidden = true;
+    $("picture").removeAttribute("src");
+    $("picture-caption").textContent = "This question is not about one object.";
   }
 }
 
@@ -155,38 +165,9 @@ function clearQuestion() {
   $("meta").textContent = "";
 }
 
-function featureTree(rows) {
-  const box = document.createElement("div");
-  box.id = "features";
-  rows.forEach((row) => {
-    const label = document.createElement("label");
-    label.style.paddingLeft = `${row.depth * 1.5}em`;
-    const check = document.createElement("input");
-    check.type = "checkbox";
-    check.value = row.number;
-    check.dataset.number = row.number;
-    check.addEventListener("change", () => {  // a group checks or clears everything under it
-      box.querySelectorAll("input").forEach((other) => {
-        if (other.value.startsWith(row.number + ".")) { other.checked = check.checked; }
-      });
-    });
-    label.append(check, ` ${row.label}`);  // words, not tree numbers: the number is the checkbox's value
-    if (row.group) { label.style.fontWeight = "600"; }
-    box.appendChild(label);
-  });
-  return box;
-}
-
-function sendFeatures(mode) {
-  // the fewest numbers: a checked group stands for everything under it
-  const checked = [...document.querySelectorAll("#features input:checked")].map((c) => c.value);
-  const numbers = checked.filter((n) => !checked.some((m) => m !== n && n.startsWith(m + ".")));
-  if (numbers.length === 0) { $("refused").textContent = "Tick at least one group or feature first."; return; }
-  send({type: "features", mode, numbers});
-}
-
 function setWaiting(on) {
   if (waiting && !on) { busySince = performance.now(); }
+  if (!on) { $("confirm").hidden = true; }  // no question open: nothing to stop from here
   const asking = !waiting && Boolean(on) && !ended;
   waiting = Boolean(on) && !ended;
   if (asking && question) { afterPaint(question.id); }
@@ -198,6 +179,7 @@ function setWaiting(on) {
 
 function showEnded(text) {
   ended = true;
+  document.body.classList.add("idle");  // no kitchen, no answer controls: nothing is asked any more
   setWaiting(false);
   question = null;
   $("screen").hidden = true;
@@ -216,66 +198,6 @@ function countdown(id, seconds) {
     if (performance.now() < end) { setTimeout(tick, 250); }
   };
   tick();
-}
-
-// -- study screens: instructions and the questionnaire ------------------------------------------------
-function showScreen(screen) {
-  const box = $("screen");
-  box.replaceChildren();
-  box.hidden = false;
-  box.dataset.title = screen.title;
-  $("ask").hidden = true;
-  status(screen.title);
-  const heading = document.createElement("h2");
-  heading.textContent = screen.title;
-  box.appendChild(heading);
-  (screen.text || "").split("\n").filter((t) => t.trim()).forEach((paragraph) => {
-    const p = document.createElement("p");
-    p.textContent = paragraph;
-    box.appendChild(p);
-  });
-  const form = document.createElement("form");
-  (screen.items || []).forEach((item, i) => form.appendChild(questionnaireItem(item, i)));
-  const submit = button(screen.button || "Continue", "", () => {
-    const answers = (screen.items || []).map((item, i) => {
-      if (item.kind === "likert") {
-        const chosen = form.querySelector(`input[name="item-${i}"]:checked`);
-        return chosen ? chosen.value : "";
-      }
-      return form.querySelector(`[name="item-${i}"]`).value;
-    });
-    socket.send(JSON.stringify({type: "screen", screen: screen.id, answers}));
-    submit.disabled = true;
-  }, true);
-  form.appendChild(submit);
-  box.appendChild(form);
-  submit.focus();
-}
-
-function questionnaireItem(item, i) {
-  const set = document.createElement("fieldset");
-  const legend = document.createElement("legend");
-  legend.textContent = item.text;
-  set.appendChild(legend);
-  if (item.kind === "likert") {
-    for (let value = item.low; value <= item.high; value++) {
-      const label = document.createElement("label");
-      const radio = document.createElement("input");
-      radio.type = "radio";
-      radio.name = `item-${i}`;
-      radio.value = String(value);
-      label.append(radio, ` ${value}${value === item.low ? " " + item.low_label : value === item.high ? " " + item.high_label : ""} `);
-      set.appendChild(label);
-    }
-  } else {
-    const text = document.createElement("textarea");
-    text.name = `item-${i}`;
-    text.rows = 2;
-    text.maxLength = 1000;
-    text.setAttribute("aria-label", item.text);
-    set.appendChild(text);
-  }
-  return set;
 }
 
 // -- answering by pointing: the camera picture and the 3D view ----------------------------------------
@@ -409,15 +331,41 @@ function objectAt(event) {
   return null;
 }
 
+// -- quitting has to be meant: "Stop this session?", with "Go on" the default ----------------------------
+function confirmOpen() { return !$("confirm").hidden; }
+
+function askToQuit() {
+  if (!question || !waiting) { return; }
+  $("confirm").hidden = false;
+  $("confirm-go-on").disabled = $("confirm-stop").disabled = false;
+  $("confirm-go-on").focus();  // Enter, Space or Escape go on; only "y" (or the button) stops
+}
+
+function closeConfirm(stop) {
+  if (!confirmOpen()) { return; }
+  $("confirm").hidden = true;
+  if (stop) { send({type: "command", command: "quit"}); }
+}
+
+$("confirm-go-on").addEventListener("click", () => closeConfirm(false));
+$("confirm-stop").addEventListener("click", () => closeConfirm(true));
+
 document.addEventListener("keydown", (event) => {
-  if (event.target.tagName === "INPUT" || event.target.tagName === "TEXTAREA" || event.ctrlKey || event.altKey || event.metaKey) { return; }
+  if (event.ctrlKey || event.altKey || event.metaKey) { return; }
+  if (confirmOpen()) {  // while the page asks whether to stop, only its answers count
+    if (event.key === "y" || event.key === "Y") { event.preventDefault(); closeConfirm(true); }
+    else if (["Escape", "n", "N", "g", "G"].includes(event.key)) { event.preventDefault(); closeConfirm(false); }
+    else if (event.key !== "Enter" && event.key !== " " && event.key !== "Tab") { event.preventDefault(); }
+    return;
+  }
+  if (event.target.tagName === "INPUT" || event.target.tagName === "TEXTAREA") { return; }
   const target = document.querySelector(`#ask button[data-key="${CSS.escape(event.key)}"]`);
   if (target && !target.disabled) { event.preventDefault(); target.click(); }
 });
 
 $("commands").addEventListener("click", (event) => {
   const command = event.target.closest("button")?.dataset.command;
-  if (command) { send({type: "command", command}); }
+  if (command === "quit") { askToQuit(); } else if (command) { send({type: "command", command}); }
 });
 
 $("typed").addEventListener("submit", (event) => {

@@ -105,8 +105,9 @@ def test_status_and_report_of_a_partly_run_study(folder, tmp_path, capsys):
     report = tmp_path / "report"
     with open(report / "turns.csv") as handle:
         turns = list(csv.DictReader(handle))
-    recorded = sum(len(read_session(path)[1]) for path in copy.glob("P0*/*.jsonl") if "questionnaire" not in path.name)
-    assert len(turns) == recorded == 3 * 3 * 8  # one row per recorded turn
+    recorded = sum(len(read_session(path)[1]) for path in copy.glob("P0*/[1-9]-*.jsonl")
+                   if "questionnaire" not in path.name)
+    assert len(turns) == recorded == 3 * 3 * 8  # one row per recorded turn of a condition (not the practice round)
     assert set(turns[0]) >= {"participant", "condition", "order", "turn", "action", "cost", "answer",
                              "answer_seconds", "refused", "accuracy"}
     with open(report / "questionnaire.csv") as handle:
@@ -202,6 +203,7 @@ def test_status_and_report_of_the_real_folder_after_a_dry_run_name_the_simulated
     monkeypatch.chdir(tmp_path)
     study = tmp_path / "my study.toml"
     study.write_text(EXAMPLE.read_text().replace("turns = 8", "turns = 2"))
+    shutil.copy(EXAMPLE.with_name("example-consent.txt"), tmp_path)  # the consent text, beside the study file
     assert main(["study", "run", str(study), "--participant", "P01", "--simulated"]) == 0
     capsys.readouterr()
     for action in ("report", "status"):
