@@ -49,14 +49,14 @@ def check_settings(args: argparse.Namespace):
         raise SettingsError(str(error).replace(str(settings.source), "the check's options", 1)) from None
 
 
-def run_rollout_check(args: argparse.Namespace, weights: str, out) -> dict:
-    """Play the check of ``weights`` and print its table (unless --json); returns the result."""
+def run_rollout_check(args: argparse.Namespace, weights: str, out, table: bool = True) -> dict:
+    """Play the check of ``weights`` and print its table (``table``); returns the result."""
     from dialog.experiments.rollout_check import checked_strategy, run_check
 
     checked = checked_strategy(weights)
     settings = check_settings(args)
     result = run_check(settings, checked)
-    if not args.json:
+    if table:
         print("\n".join(check_table(result)), file=out, flush=True)
     return result
 

@@ -157,7 +157,7 @@ def check_only(args: argparse.Namespace, out) -> int:
     if fit_options:
         raise SettingsError(f"--check WEIGHTS checks weights without fitting: {', '.join(fit_options)} do(es) not "
                             "apply (fit with --demos and --out; every fit runs the check on what it writes)")
-    result = run_rollout_check(args, args.check, out)
+    result = run_rollout_check(args, args.check, out, table=not args.json)
     if args.json:
         print_json(result, file=out)
     return 0 if result["passes"] else 1
@@ -166,16 +166,14 @@ def check_only(args: argparse.Namespace, out) -> int:
 def ship_rule(args: argparse.Namespace, out) -> dict:
     """The rollout check of the weights just written (issue 49), which the ship rule requires: {"ship_rule",
     "rollout_check"}; the ship rule's ``passes`` is None when the check was skipped (--no-check)."""
-    rule = "the fit's own choice of fit, and the rollout check of what it wrote (docs/irl.md)"
+    from dialog.experiments.rollout_check import ship_rule_record
+
     if getattr(args, "no_check", False):
         print("ship rule: not judged (--no-check: the rollout check was skipped)", file=out, flush=True)
-        return {"ship_rule": {"passes": None, "rule": rule, "why": "--no-check"}, "rollout_check": None}
+        return ship_rule_record(None)
     result = run_rollout_check(args, str(args.out), out)
-    verdict = "passes" if result["passes"] else "FAILS (its rollout check failed)"
-    print(f"ship rule: {verdict}", file=out, flush=True)
-    summary = {key: result[key] for key in ("passes", "criteria", "checked_summary", "expert_summary",
-                                            "allocation", "settings", "seconds")}
-    return {"ship_rule": {"passes": bool(result["passes"]), "rule": rule}, "rollout_check": summary}
+    print(f"ship rule: {'passes' if result['passes'] else 'FAILS (its rollout check failed)'}", file=out, flush=True)
+    return ship_rule_record(result)
 
 
 def unidentified_features(learned) -> tuple[str, ...]:

@@ -99,3 +99,17 @@ def run_check(settings: CheckSettings, checked: Checked) -> dict:
             "settings": settings.source, **verdict,
             "episodes": {"checked": episode_rows(rollouts[half:]), "expert": episode_rows(rollouts[:half])},
             "seconds": round(time.perf_counter() - started, 2)}
+
+
+SHIP_RULE = "the fit's own choice of fit, and the rollout check of the weights it wrote (docs/irl.md)"
+
+
+def ship_rule_record(result: dict | None) -> dict:
+    """What a fit's report records (issue 49): {"ship_rule", "rollout_check"}; the rule's ``passes`` is None
+    when the check was not run (``result`` None), else the check's verdict, with the check's summary beside it."""
+    if result is None:
+        return {"ship_rule": {"passes": None, "rule": SHIP_RULE, "why": "the rollout check was skipped"},
+                "rollout_check": None}
+    summary = {key: result[key] for key in ("checked", "passes", "criteria", "checked_summary", "expert_summary",
+                                            "allocation", "settings", "seconds")}
+    return {"ship_rule": {"passes": bool(result["passes"]), "rule": SHIP_RULE}, "rollout_check": summary}
