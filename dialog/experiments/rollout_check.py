@@ -83,6 +83,14 @@ def check_specs(settings: CheckSettings, checked: Checked, scratch: str) -> tupl
     return specs, allocation
 
 
+def shown(path: str) -> str:
+    """A path as the tables show it: relative to the repository when inside it."""
+    try:
+        return str(Path(path).resolve().relative_to(REPOSITORY))
+    except ValueError:
+        return path
+
+
 def run_check(settings: CheckSettings, checked: Checked) -> dict:
     """Play both strategies' episodes and judge them; the result is plain data (JSON) with the verdict."""
     started = time.perf_counter()
@@ -96,7 +104,7 @@ def run_check(settings: CheckSettings, checked: Checked) -> dict:
     verdict = judge(rollouts[half:], rollouts[:half], settings)
     return {"checked": checked.label, "weights": None if checked.weights is None else dict(checked.weights.values),
             "expert": settings.expert, "allocation": allocation, "spending_at": list(settings.spending_at),
-            "settings": settings.source, **verdict,
+            "settings": shown(settings.source), **verdict,
             "episodes": {"checked": episode_rows(rollouts[half:]), "expert": episode_rows(rollouts[:half])},
             "seconds": round(time.perf_counter() - started, 2)}
 
