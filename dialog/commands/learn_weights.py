@@ -7,6 +7,8 @@ one a rule fixed in advance picks (learning.irl.imitation).
 rollouts of the real dialog loop in the training condition (dialog.experiments.irl_rollouts), the iterate kept by
 the final accuracy of greedy episodes on validation seeds. ``--method per-turn``: the per-turn fits of
 learning.irl.maxent, kept by agreement with held-out demonstrations.
+``--check WEIGHTS`` (issue 49): no fit; play the weights beside the scripted expert and judge how they ask
+(dialog.commands._rollout_check). Every fit runs that check on what it wrote: the ship rule requires it.
 """
 
 from __future__ import annotations
