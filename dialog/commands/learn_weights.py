@@ -27,6 +27,7 @@ from dialog.user_weights import UserWeights
 from learning.errors import OutputPathError, SettingsError
 
 # Trajectory defaults: sized so that 100 iterations fit in about 10 minutes on a 2-core machine (docs/irl.md).
+CHECK_OPTIONS = ("settings", "seeds", "datasets", "data_seed", "turns", "workers")  # --check-* (the rollout check)
 ROLLOUTS_PER_ITERATION = 6
 VALIDATION_EPISODES = 8
 EVALUATE_EVERY = 2
@@ -111,6 +112,11 @@ def run(args: argparse.Namespace, output_stream=None) -> int:
     if args.demos is None or args.out is None:
         raise SettingsError(f"{'--demos' if args.demos is None else '--out'} is required to fit weights (--demos "
                             "DIR_OR_shipped --out FILE.toml); to check weights without fitting, give --check WEIGHTS")
+    if getattr(args, "no_check", False):
+        given = [f"--check-{name.replace('_', '-')}" for name in CHECK_OPTIONS if getattr(args, f"check_{name}", None)]
+        if given:
+            raise SettingsError(f"{', '.join(given)} set(s) the rollout check, which --no-check skips; give one or "
+                                "the other")
     if args.out.suffix != ".toml":
         raise OutputPathError(f"--out {args.out}: a weights file must end in .toml")
     method = getattr(args, "method", "per-turn")

@@ -92,6 +92,8 @@ def test_the_table_names_every_episode_the_criteria_and_the_verdict(small, tmp_p
     (["--check", "dt-task-env", "--check-data-seed", "0"], "calibration data, data seed >= 101"),
     (["--check", "dt-task-env", "--demos", "shipped"], "--demos do(es) not apply"),
     ([], "--demos is required to fit"),
+    (["--demos", "shipped", "--out", "never-written.toml", "--no-check", "--check-seeds", "31"],
+     "--check-seeds set(s) the rollout check, which --no-check skips"),
 ])
 def test_bad_input_is_one_line_and_exit_2(argv, words, capsys):
     assert main(["learn-weights", *argv]) == 2
