@@ -8,7 +8,10 @@ learning/irl/fit-report-dt-task-env.json. ``--eleven`` refits issue 27's seven-p
 (dt-task-env-v1.toml, its ablations dt-task-env-no-env.toml and dt-task-habits.toml by the rule fixed in
 advance, ``ablation_weights``, and fit-report-dt-task-env-v1.json). docs/irl.md.
 
-    .venv/bin/python scripts/fit_dt_task_env.py [--eleven] [--json]
+    .venv/bin/python scripts/fit_dt_task_env.py [--eleven] [--json] [--no-check]
+
+The ship rule requires the rollout check (issue 49, learning/irl/rollout-check.toml) of the written weights: the
+report records it, and the script exits 1 when it fails (--no-check skips it: the rule is then not judged).
 """
 
 from __future__ import annotations
@@ -23,11 +26,13 @@ sys.path.insert(0, str(ROOT))
 
 from dialog.experiments.irl_rollouts import training_condition  # noqa: E402
 from dialog.experiments.provenance import git_commit  # noqa: E402
+from dialog.experiments.rollout_check import checked_strategy, run_check, ship_rule_record  # noqa: E402
 from learning.datafiles import read_toml  # noqa: E402
 from learning.decision.weights import WEIGHTS_DIRECTORY  # noqa: E402
 from learning.decision.weights_file import DecisionWeights, load_weights, save_weights  # noqa: E402
 from learning.irl.imitation import ablation_weights  # noqa: E402
 from learning.irl.learn import SHIPPED, learn_imitation_weights, weights_comment  # noqa: E402
+from learning.irl.rollout_check import load_check_settings  # noqa: E402
 
 IRL = ROOT / "learning" / "irl"
 PLAN = IRL / "fit-plan-dt-task-env.toml"
@@ -80,10 +85,14 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--eleven", action="store_true", help="refit issue 27's dt-task-env-v1 and its ablations")
     parser.add_argument("--json", action="store_true")
+    parser.add_argument("--no-check", action="store_true", help="skip the rollout check the ship rule requires")
     args = parser.parse_args()
     commit = git_commit()
     learned, report_path = fit_eleven(commit) if args.eleven else fit_seven(commit)
-    report_path.write_text(json.dumps(learned.summary(), indent=1) + "\n", encoding="utf-8")
+    preset = WEIGHTS_DIRECTORY / ("dt-task-env-v1.toml" if args.eleven else "dt-task-env.toml")
+    checked = None if args.no_check else run_check(load_check_settings(), checked_strategy(str(preset)))
+    summary = {**learned.summary(), **ship_rule_record(checked)}
+    report_path.write_text(json.dumps(summary, indent=1) + "\n", encoding="utf-8")
     report = learned.report
     print(f"{len(learned.fits)} fits in {learned.seconds:.1f} s; kept {report['policy']} split "
           f"{report['kept']['split_seed']} fit seed {report['kept']['fit_seed']}")
@@ -93,9 +102,12 @@ def main() -> int:
                       "thesis_features_per_turn_fit": report["thesis_features_per_turn_fit"]}, indent=1))
     for name, value in learned.weights.as_dict().items():
         print(f"  {name:<30} {value:>12.4f}")
+    passes = summary["ship_rule"]["passes"]
+    print("ship rule: " + {None: "not judged (--no-check)", True: "passes", False: "FAILS (its rollout check failed)"}[
+        passes])
     if args.json:
-        print(json.dumps(learned.summary()))
-    return 0
+        print(json.dumps(summary))
+    return 1 if passes is False else 0
 
 
 if __name__ == "__main__":

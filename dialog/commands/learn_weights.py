@@ -7,6 +7,8 @@ one a rule fixed in advance picks (learning.irl.imitation).
 rollouts of the real dialog loop in the training condition (dialog.experiments.irl_rollouts), the iterate kept by
 the final accuracy of greedy episodes on validation seeds. ``--method per-turn``: the per-turn fits of
 learning.irl.maxent, kept by agreement with held-out demonstrations.
+``--check WEIGHTS`` (issue 49): no fit; play the weights beside the scripted expert and judge how they ask
+(dialog.commands._rollout_check). Every fit runs that check on what it wrote: the ship rule requires it.
 """
 
 from __future__ import annotations
@@ -17,6 +19,7 @@ import time
 
 from dialog.commands._arguments import positive_int, seed
 from dialog.commands._json import print_json, strict_json
+from dialog.commands._rollout_check import add_check_options, run_rollout_check
 from dialog.experiments.provenance import git_commit
 from dialog.output_paths import check_writable, file_argument, make_parent, writing
 from dialog.printed_command import command_line
@@ -24,6 +27,7 @@ from dialog.user_weights import UserWeights
 from learning.errors import OutputPathError, SettingsError
 
 # Trajectory defaults: sized so that 100 iterations fit in about 10 minutes on a 2-core machine (docs/irl.md).
+CHECK_OPTIONS = ("settings", "seeds", "datasets", "data_seed", "turns", "workers")  # --check-* (the rollout check)
 ROLLOUTS_PER_ITERATION = 6
 VALIDATION_EPISODES = 8
 EVALUATE_EVERY = 2
@@ -37,11 +41,11 @@ def register(commands) -> None:
                     "over splits of the demonstrations and random starts, judged by how well they imitate held-out "
                     "demonstrations; --method trajectory is the thesis's trajectory-level fit of eq. 7.7 (the "
                     "learner's feature counts from rollouts of the dialog loop), --method per-turn one per-turn fit.")
-    parser.add_argument("--demos", required=True, metavar="DIR_OR_shipped",
+    parser.add_argument("--demos", default=None, metavar="DIR_OR_shipped",
                         help="a directory of .json/.npz demonstrations (teachbot expert --out), one such file, or "
-                             "'shipped' (learning/irl/expert-demos)")
-    parser.add_argument("--out", type=file_argument, required=True, metavar="FILE.toml",
-                        help="the weights file to write")
+                             "'shipped' (learning/irl/expert-demos); required to fit")
+    parser.add_argument("--out", type=file_argument, default=None, metavar="FILE.toml",
+                        help="the weights file to write; required to fit")
     parser.add_argument("--method", choices=("imitation", "trajectory", "per-turn"), default="imitation",
                         help="imitation (default): per-turn MaxEnt fits over --split-seeds x --fit-seeds, judged by "
                              "held-out imitation (docs/irl.md); trajectory: eq. 7.7 with rollouts of the dialog "
@@ -92,7 +96,9 @@ def register(commands) -> None:
                         help="write the weights even when they can never ask (all zero but remaining_time's), which "
                              "is otherwise refused: such a DT stays quiet every turn")
     parser.add_argument("--json", action="store_true", help="end with one JSON line: iterations, seconds, weights, "
-                                                             "validation_agreement")
+                                                             "validation_agreement, the rollout check and the ship "
+                                                             "rule; with --check, the check's result")
+    add_check_options(parser)
     parser.set_defaults(handler=run)
 
 
@@ -101,6 +107,16 @@ def run(args: argparse.Namespace, output_stream=None) -> int:
     from learning.irl.learn import weights_comment
 
     out = output_stream or sys.stdout
+    if getattr(args, "check", None) is not None:
+        return check_only(args, out)
+    if args.demos is None or args.out is None:
+        raise SettingsError(f"{'--demos' if args.demos is None else '--out'} is required to fit weights (--demos "
+                            "DIR_OR_shipped --out FILE.toml); to check weights without fitting, give --check WEIGHTS")
+    if getattr(args, "no_check", False):
+        given = [f"--check-{name.replace('_', '-')}" for name in CHECK_OPTIONS if getattr(args, f"check_{name}", None)]
+        if given:
+            raise SettingsError(f"{', '.join(given)} set(s) the rollout check, which --no-check skips; give one or "
+                                "the other")
     if args.out.suffix != ".toml":
         raise OutputPathError(f"--out {args.out}: a weights file must end in .toml")
     method = getattr(args, "method", "per-turn")
@@ -129,15 +145,43 @@ def run(args: argparse.Namespace, output_stream=None) -> int:
         note = "  (unidentified: equal on every candidate)" if name in unidentified else ""
         print(f"  {name:<30} {value:>12.4f}{note}", file=out)
     print(f"wrote {args.out}", file=out)
+    summary = {**learned.summary(), **ship_rule(args, out)}
     if getattr(args, "report", None) is not None:
         make_parent(args.report, "fit report")
         with writing(args.report, "fit report"):
-            args.report.write_text(strict_json(learned.summary(), indent=1) + "\n", encoding="utf-8")
+            args.report.write_text(strict_json(summary, indent=1) + "\n", encoding="utf-8")
         print(f"wrote {args.report}", file=out)
     fitted.warn_if_never_asks()
     if args.json:
-        print_json(learned.summary(), file=out)
-    return 0
+        print_json(summary, file=out)
+    return 1 if summary["ship_rule"]["passes"] is False else 0
+
+
+def check_only(args: argparse.Namespace, out) -> int:
+    """``--check WEIGHTS``: the rollout check alone; fit options are refused rather than ignored."""
+    fit_options = [name for name, given in (("--demos", args.demos is not None), ("--out", args.out is not None),
+                                            ("--no-check", getattr(args, "no_check", False)))
+                   if given]
+    if fit_options:
+        raise SettingsError(f"--check WEIGHTS checks weights without fitting: {', '.join(fit_options)} do(es) not "
+                            "apply (fit with --demos and --out; every fit runs the check on what it writes)")
+    result = run_rollout_check(args, args.check, out, table=not args.json)
+    if args.json:
+        print_json(result, file=out)
+    return 0 if result["passes"] else 1
+
+
+def ship_rule(args: argparse.Namespace, out) -> dict:
+    """The rollout check of the weights just written (issue 49), which the ship rule requires: {"ship_rule",
+    "rollout_check"}; the ship rule's ``passes`` is None when the check was skipped (--no-check)."""
+    from dialog.experiments.rollout_check import ship_rule_record
+
+    if getattr(args, "no_check", False):
+        print("ship rule: not judged (--no-check: the rollout check was skipped)", file=out, flush=True)
+        return ship_rule_record(None)
+    result = run_rollout_check(args, str(args.out), out)
+    print(f"ship rule: {'passes' if result['passes'] else 'FAILS (its rollout check failed)'}", file=out, flush=True)
+    return ship_rule_record(result)
 
 
 def unidentified_features(learned) -> tuple[str, ...]:

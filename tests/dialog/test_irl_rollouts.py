@@ -95,7 +95,7 @@ def test_learn_weights_by_trajectory_on_the_real_loop_writes_weights_with_proven
     out = tmp_path / "w.toml"
     assert main(["learn-weights", "--demos", "shipped", "--out", str(out), "--method", "trajectory",
                  "--iterations", "2", "--rollouts", "2",
-                 "--validation-episodes", "2", "--evaluate-every", "1", "--workers", "2", "--json"]) == 0
+                 "--validation-episodes", "2", "--evaluate-every", "1", "--workers", "2", "--no-check", "--json"]) == 0
     printed = capsys.readouterr().out
     assert "iteration   2/2" in printed and "total" in printed and "validation accuracy" in printed
     weights = load_weights(out, EXTENDED_FEATURE_NAMES)  # the shipped demonstrations record the habits too

@@ -18,11 +18,13 @@ def test_learn_weights_per_turn_on_the_shipped_demos_prints_the_summary(tmp_path
     from learning.decision.habits import EXTENDED_FEATURE_NAMES
 
     out = tmp_path / "w.toml"
-    assert main(["learn-weights", "--demos", "shipped", "--out", str(out), "--method", "per-turn", "--json"]) == 0
+    assert main(["learn-weights", "--demos", "shipped", "--out", str(out), "--method", "per-turn", "--no-check",
+                 "--json"]) == 0
     captured = capsys.readouterr()
     assert "cannot identify remaining_time" in captured.err  # named, and left at 0
     summary = json.loads(captured.out.strip().splitlines()[-1])
-    assert set(summary) == {"iterations", "seconds", "weights", "validation_agreement"}
+    assert set(summary) == {"iterations", "seconds", "weights", "validation_agreement", "ship_rule", "rollout_check"}
+    assert summary["ship_rule"]["passes"] is None and summary["rollout_check"] is None  # --no-check: not judged
     assert 0.0 <= summary["validation_agreement"] <= 1.0 and 1 <= summary["iterations"] <= 100
     assert list(summary["weights"]) == list(EXTENDED_FEATURE_NAMES) and summary["weights"]["remaining_time"] == 0.0
     np.testing.assert_array_equal(load_weight_file(out), [summary["weights"][n] for n in EXTENDED_FEATURE_NAMES])
@@ -45,7 +47,7 @@ def test_a_fit_that_can_never_ask_is_refused_unless_allowed(tmp_path, capsys):
     assert "nothing written" in error and "can never ask" in error and "--allow-degenerate" in error
     assert not out.exists()
     assert main(["learn-weights", "--demos", str(demos), "--out", str(out), "--method", "per-turn",
-                 "--allow-degenerate"]) == 0
+                 "--allow-degenerate", "--no-check"]) == 0
     assert sum("never asks" in line for line in capsys.readouterr().err.splitlines()) == 1 and out.exists()
 
 
