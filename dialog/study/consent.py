@@ -22,7 +22,7 @@ from pathlib import Path
 
 from dialog import software_version
 from dialog.output_paths import superseded_name
-from dialog.study.files import write_atomically
+from dialog.study.atomic import write_atomically
 from dialog.study.records import SOFTWARE_PATTERN, _json_lines, _shown
 from learning import datafiles as df
 from learning.errors import TeachbotError, TranscriptError

@@ -15,12 +15,12 @@ replace=False)``), and a session whose records disagree with each other or with 
 
 from __future__ import annotations
 
-import os
 from dataclasses import dataclass
 from pathlib import Path
 
 from dialog import software_version
 from dialog.output_paths import superseded_name, writing
+from dialog.study.consent import consent_problem
 from dialog.study.records import (
     expected_session,
     read_abort_note,
@@ -29,7 +29,7 @@ from dialog.study.records import (
     torn_tail,
 )
 from learning import datafiles as df
-from learning.errors import OutputPathError, TeachbotError, TranscriptError
+from learning.errors import TeachbotError, TranscriptError
 
 STATES = ("missing", "running", "questionnaire", "done", "aborted", "damaged")
 
@@ -141,8 +141,6 @@ def _refuse_unfinished(files: SessionFiles, how: str) -> None:
 
 def session_state_of(study, participant: str, position: int, name: str) -> SessionState:
     """:func:`session_state` of one participant's session at ``position`` (from 1) under condition ``name``."""
-    from dialog.study.consent import consent_problem  # consent records are written with write_atomically
-
     condition = study.condition(name)
     try:
         files = session_files(study, participant, position, name)
@@ -154,36 +152,6 @@ def session_state_of(study, participant: str, position: int, name: str) -> Sessi
     items = () if position == 0 else study.items  # the practice round (position 0) has no questionnaire
     return session_state(files, condition, study_header(study, participant, name, position),
                          expected_session(study, participant, position, condition), items)
-
-
-def write_atomically(path: Path, text: str, what: str, *, replace: bool = True) -> None:
-    """Write ``text`` to ``path`` through a temporary file and a rename: the record is there whole or not at all.
-
-    With ``replace=False`` (recorded answers) an existing ``path`` is never written over: the temporary file
-    is linked into place, which fails if the name is taken, and the refusal names the file. The temporary file
-    is removed however the call ends; text that is not valid Unicode (a lone surrogate) is a ``ValueError``
-    before anything is opened (the callers check what people type first: ``questionnaire.text_problem``).
-    """
-    data = text.encode("utf-8")  # text that can't be encoded fails here, before any file is opened
-    temporary = path.with_name(f".{path.name}.tmp")
-    with writing(path, what):
-        path.parent.mkdir(parents=True, exist_ok=True)
-        try:
-            with open(temporary, "wb") as handle:
-                handle.write(data)
-                handle.flush()
-                os.fsync(handle.fileno())
-            if replace:
-                os.replace(temporary, path)
-                return
-            try:
-                os.link(temporary, path)
-            except FileExistsError:
-                raise OutputPathError(f"{path}: already holds the {what}; teachbot never writes over recorded "
-                                      "answers (run the condition again with --condition NAME --again to keep "
-                                      "them as *.superseded-N)") from None
-        finally:  # the temporary file never outlives the call, whatever happened
-            temporary.unlink(missing_ok=True)
 
 
 def supersede(files: SessionFiles) -> list[Path]:

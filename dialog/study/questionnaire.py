@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import json
 
-from dialog.study.files import write_atomically
+from dialog.study.atomic import write_atomically
 from dialog.transcripts.records import TEXT_ACCEPTED, text_problem
 
 SKIP_WORDS = ("skip", "pass", "-")

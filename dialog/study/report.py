@@ -17,7 +17,7 @@ from matplotlib.ticker import MaxNLocator
 from dialog import software_version
 from dialog.experiments.figures import COLOURS, LINE_STYLES
 from dialog.output_paths import check_writable, writing
-from dialog.study.files import write_atomically
+from dialog.study.atomic import write_atomically
 from dialog.study.paired import paired_test
 from dialog.study.tables import ANSWER_COLUMNS, TURN_COLUMNS, collect, write_csv
 from learning.errors import TranscriptError

@@ -19,6 +19,7 @@ from dialog.output_paths import check_writable
 from dialog.printed_command import command_line
 from dialog.session import SessionSettings, open_session
 from dialog.study import consent, questionnaire
+from dialog.study.atomic import write_atomically
 from dialog.study.design import assigned_orders, questionnaire_rng, session_seed
 from dialog.study.files import (
     read_transcript_checked,
@@ -26,7 +27,6 @@ from dialog.study.files import (
     session_state_of,
     study_header,
     supersede,
-    write_atomically,
 )
 from dialog.study.records import expected_session
 from dialog.study.studyfile import PRACTICE

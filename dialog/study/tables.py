@@ -89,7 +89,7 @@ def write_csv(path, columns, rows) -> None:
     import csv
     import io
 
-    from dialog.study.files import write_atomically
+    from dialog.study.atomic import write_atomically
 
     buffer = io.StringIO()
     writer = csv.DictWriter(buffer, fieldnames=list(columns), lineterminator="\n")
