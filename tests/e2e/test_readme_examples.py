@@ -102,13 +102,13 @@ def test_every_moved_example_is_still_shown_by_its_doc():
 @pytest.mark.parametrize("command", [c for c in COMMANDS if c not in SKIPPED])
 def test_a_readme_example_runs_as_written(command, tmp_path):
     argv = [str(TEACHBOT), *shlex.split(command)[1:]]
-    for argument in argv[1:]:  # a file of the clone the example names (a study file, rl:POLICY) is copied beside it
-        name = argument.removeprefix("rl:")
+    for argument in argv[1:]:  # a file of the clone the example names (a study file, rl:POLICY) is copied, with
+        name = argument.removeprefix("rl:")  # the files beside it that it names (a consent text, the policy's npz)
         source = README.parent / name
         if not name.startswith("-") and "/" in name and source.is_file():
             (tmp_path / name).parent.mkdir(parents=True, exist_ok=True)
-            for part in (source, source.with_suffix(".npz")) if argument.startswith("rl:") else (source,):
-                shutil.copy(part, tmp_path / Path(name).with_suffix(part.suffix))
+            for part in (p for p in source.parent.iterdir() if p.is_file()):
+                shutil.copy(part, (tmp_path / name).parent / part.name)
     returncode, stderr = run_in_own_group(argv, tmp_path)
     assert returncode == 0, f"{command} exited {returncode}:\n{stderr[-2000:]}"
     assert "Traceback" not in stderr
