@@ -122,6 +122,7 @@ class CalibrationTask:
     spec: EpisodeSpec
     accuracy_what_if: bool = True
     record: bool = True  # False: the same episode without the recorder (the test that it changes nothing)
+    feature_guesses: bool = False  # also probe the FSQ's guessed answers (dialog.experiments.fsq_guesses)
 
 
 def play(task: CalibrationTask) -> dict:
@@ -145,14 +146,21 @@ def play(task: CalibrationTask) -> dict:
                 actions.append(record["action"])
 
         observers = (recorder, Actions()) if task.record else (Actions(),)
+        if task.feature_guesses:
+            from dialog.experiments.fsq_guesses import FeatureGuessProbe
+
+            probe = FeatureGuessProbe(pools.task.relevant_features)
+            observers += (probe,)
         with TranscriptWriter(str(Path(scratch) / "episode.jsonl")) as transcript:
             manager = build_episode(settings, environment, teacher, transcript, strategy=strategy, rngs=rngs,
                                     say=lambda _: None, clock=timing.clock, observers=observers)
             recorder.attach(manager)
+            if task.feature_guesses:
+                probe.attach(manager)
             result = manager.run()
     return {"strategy": spec.strategy, "dataset": spec.dataset, "seed": spec.seed, "accuracy": result.accuracy,
             "records": recorder.finish(result.accuracy) if task.record else [], "quiet_turns": recorder.quiet_turns,
-            "actions": actions}
+            "actions": actions, "feature_guesses": probe.records if task.feature_guesses else []}
 
 
 def calibration_specs(strategies, data_seed: int, datasets: int, seeds, turns: int | None = None,
@@ -166,9 +174,10 @@ def calibration_specs(strategies, data_seed: int, datasets: int, seeds, turns: i
             for s in strategies for d in range(datasets) for seed in seeds]
 
 
-def run_calibration(specs: list[EpisodeSpec], workers: int = 2, accuracy_what_if: bool = True) -> list[dict]:
-    """Play every spec with the recorder, on ``workers`` processes; results in spec order."""
-    tasks = [CalibrationTask(spec, accuracy_what_if) for spec in specs]
+def run_calibration(specs: list[EpisodeSpec], workers: int = 2, accuracy_what_if: bool = True,
+                    feature_guesses: bool = False) -> list[dict]:
+    """Play every spec with the recorder (and the FSQ-guess probe), on ``workers`` processes; results in spec order."""
+    tasks = [CalibrationTask(spec, accuracy_what_if, feature_guesses=feature_guesses) for spec in specs]
     if workers == 1 or len(tasks) == 1:
         return [play(task) for task in tasks]
     with ProcessPoolExecutor(workers) as pool:

@@ -1,0 +1,114 @@
+"""The feature question's guessed answers against the teacher's (issue 49 item 3; ``learning.whatif.feature_guesses``).
+
+On every turn the FSQ is still open and the training set holds an example, :class:`FeatureGuessProbe` records,
+without changing the episode:
+
+* for each guess of the teacher's answer, the predicted change of the learning features, E[phi_L(s') | FSQ] -
+  phi_L(s), and of held-out accuracy, every answer refit exactly (``refit_probabilities``);
+* the change the teacher's real answer (the task's relevant features, what the scripted teacher says with
+  feature quality 1) would make, refit the same way: the "realised" change, the target every guess is judged by;
+* every label and demonstration question's expected change of the learning features (the fast what-if of eq. 7.1),
+  to count the states where one instance question is at least as good as the real answer on every learning
+  feature: there no weights with the thesis's signs (every learning feature weighed >= 0, the FSQ's higher cost
+  weighed <= 0) can prefer even a perfectly guessed FSQ.
+
+Only the teacher's relevant features and the held-out pool are read beyond the learner's state; they are the
+measurement, never an input of any guess.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from learning.decision.candidates import expected_decision_features
+from learning.decision.features import LEARNING_FEATURES, concept_counts, learning_features
+from learning.evaluation import accuracy
+from learning.whatif.feature_guesses import GUESSES, guessed_answers, refit_probabilities
+
+K = len(LEARNING_FEATURES)
+
+
+def _accuracy(P: np.ndarray, concepts, truth) -> float:
+    return accuracy(np.array(concepts, dtype=object)[np.argmax(P, axis=-1)], truth)
+
+
+def answer_effect(state, answers, test_X, test_y) -> tuple[np.ndarray, float]:
+    """E[(phi_L, held-out accuracy)] over ``answers`` (probability, subsets), each refit exactly; with no answer
+    the FSQ changes nothing and the current values come back."""
+    if not answers:
+        return learning_features(state.probabilities(), concept_counts(state))[:K], \
+            _accuracy(state.probabilities(test_X), state.concepts, test_y)
+    rows = np.vstack([state.scene_X, test_X])
+    counts, n = concept_counts(state), len(state.scene_X)
+    phi, acc = np.zeros(K), 0.0
+    for probability, subsets in answers:
+        P = refit_probabilities(state, subsets, rows)
+        phi += probability * learning_features(P[:n], counts)[:K]
+        acc += probability * _accuracy(P[n:], state.concepts, test_y)
+    return phi, acc
+
+
+class FeatureGuessProbe:
+    """A manager observer: one record per decision with the FSQ open and an example learned (module docstring)."""
+
+    def __init__(self, relevant_features, guesses=GUESSES):
+        self.relevant, self.guesses = tuple(relevant_features), tuple(guesses)
+        self.manager = None
+        self.records: list[dict] = []
+
+    def attach(self, manager) -> None:
+        self.manager = manager
+
+    def on_decision(self, decision) -> None:
+        state = self.manager.state
+        if state.feature_query_asked or len(state.training_matrix()[0]) == 0:
+            return
+        test_X, test_y = self.manager._test  # the held-out pool the manager scores (drawn once, read here)
+        phi = learning_features(state.probabilities(), concept_counts(state))[:K]
+        acc = _accuracy(state.probabilities(test_X), state.concepts, test_y)
+        names = list(state.feature_names)
+        teacher = np.array(sorted(names.index(name) for name in self.relevant))
+        real_phi, real_acc = answer_effect(state, [(1.0, {c: teacher for c in state.concepts})], test_X, test_y)
+        record = {"turn": self.manager.turn + 1, "examples": len(state.training_matrix()[0]),
+                  "action": decision.action.kind, "phi": phi.tolist(), "accuracy": acc,
+                  "realised": (real_phi - phi).tolist(), "realised_accuracy": real_acc - acc, "guesses": {}}
+        for guess in self.guesses:
+            guess_phi, guess_acc = answer_effect(state, guessed_answers(state, guess), test_X, test_y)
+            record["guesses"][guess] = {"predicted": (guess_phi - phi).tolist(), "predicted_accuracy": guess_acc - acc}
+        table = expected_decision_features(state)
+        instance = [i for i, a in enumerate(table.actions) if a.kind in ("label", "demo")]
+        record["instance"] = (table.expected[instance, :K] - phi).tolist()
+        self.records.append(record)
+
+    def on_turn(self, record: dict, scene) -> None:
+        pass
+
+
+def dominated(record: dict, predicted: list[float] | None = None) -> bool:
+    """One label or demonstration question expected at least as good on every learning feature as the FSQ's
+    change (the teacher's real one unless ``predicted`` is given)."""
+    fsq = np.array(record["realised"] if predicted is None else predicted)
+    instance = np.array(record["instance"])
+    return bool(len(instance) and (instance >= fsq - 1e-12).all(axis=1).any())
+
+
+TARGETS = ("classifier_discriminability", "instance_variation", "prediction_margin", "accuracy")
+
+
+def guess_table(records: list[dict], guesses=GUESSES) -> list[dict]:
+    """Per guess and target: n, mean predicted, mean realised, Pearson r (None when a side is constant), mean
+    absolute error; and per guess the states where its own prediction is dominated."""
+    rows = []
+    for guess in guesses:
+        for target in TARGETS:
+            if target == "accuracy":
+                p = np.array([r["guesses"][guess]["predicted_accuracy"] for r in records])
+                q = np.array([r["realised_accuracy"] for r in records])
+            else:
+                j = LEARNING_FEATURES.index(target)
+                p = np.array([r["guesses"][guess]["predicted"][j] for r in records])
+                q = np.array([r["realised"][j] for r in records])
+            r = float(np.corrcoef(p, q)[0, 1]) if len(p) > 1 and p.std() > 0 and q.std() > 0 else None
+            rows.append({"guess": guess, "target": target, "n": len(p), "predicted": float(p.mean()),
+                         "realised": float(q.mean()), "correlation": r, "mae": float(np.abs(p - q).mean())})
+    return rows
