@@ -3,8 +3,9 @@
 Plays the strategies of dialog/data/calibration/fsq-guesses.toml in the training allocation on calibration data
 and, on every turn the FSQ is open (``dialog.experiments.fsq_guesses``), compares each guess of the teacher's
 answer (``learning.whatif.feature_guesses``) with the change the real answer would make: mean predicted and
-realised change, Pearson r and mean absolute error for ACD, IV, PM and held-out accuracy; and counts the states
-where one label or demonstration question is at least as good as the real answer on every learning feature.
+realised change, Pearson r and mean absolute error for ACD, IV, PM and held-out accuracy; counts the states
+where one label or demonstration question is at least as good as the real answer on every learning feature, and
+groups the real answer's one-step change by the examples the learner holds.
 Applies the file's rule and prints its verdict; --json ends with one JSON line.
 
     .venv/bin/python scripts/fsq_guesses.py --data choice|confirmation [--json] [--datasets N] [--seeds N ...]
@@ -21,7 +22,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from dialog.experiments.fsq_guesses import TARGETS, dominated, guess_table  # noqa: E402
+from dialog.experiments.fsq_guesses import by_examples, dominated, guess_table  # noqa: E402
 from dialog.experiments.provenance import git_commit  # noqa: E402
 from dialog.experiments.whatif_calibration import calibration_specs, run_calibration  # noqa: E402
 from learning.datafiles import check_keys, integer, numbers, read_toml, texts  # noqa: E402
@@ -94,11 +95,17 @@ def main(argv=None) -> int:
     print(f"turns 1-5: the real answer is dominated by one instance question in "
           f"{counts['real_answer_dominated_early']} of {counts['early_states']} states "
           f"(later turns: {counts['real_answer_dominated_later']} of {len(records) - len(early)})")
+    groups = by_examples(records)
+    print("| examples | states | real answer: ACD | real answer: held-out accuracy | best instance question: ACD |")
+    print("|---|---:|---:|---:|---:|")
+    for g in groups:
+        best = "–" if g["best_instance_acd"] is None else f"{g['best_instance_acd']:+.4f}"
+        print(f"| {g['examples']} | {g['states']} | {g['real_acd']:+.4f} | {g['real_accuracy']:+.4f} | {best} |")
     print("rule (lower MAE than", config["baseline"], "on", ", ".join(SHORT[t] for t in config["targets"]) + "):",
           ", ".join(better) or "no guess passes")
     if args.json:
         print(json.dumps({"data": args.data, "data_seed": run["data_seed"], "datasets": datasets, "seeds": seeds,
-                          "commit": git_commit(), "rows": rows, "counts": counts, "better": better,
+                          "commit": git_commit(), "rows": rows, "counts": counts, "by_examples": groups, "better": better,
                           "per_strategy_states": {s: sum(r["strategy"] == s for r in records)
                                                   for s in config["strategies"]}}))
     return 0

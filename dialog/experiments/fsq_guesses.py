@@ -112,3 +112,22 @@ def guess_table(records: list[dict], guesses=GUESSES) -> list[dict]:
             rows.append({"guess": guess, "target": target, "n": len(p), "predicted": float(p.mean()),
                          "realised": float(q.mean()), "correlation": r, "mae": float(np.abs(p - q).mean())})
     return rows
+
+
+EXAMPLE_GROUPS = ((1, 2), (3, 5), (6, 10), (11, 20), (21, None))
+
+
+def by_examples(records: list[dict]) -> list[dict]:
+    """The real answer's mean one-step change (ACD, held-out accuracy) beside the best label or demonstration
+    question's predicted ACD change, with the states grouped by how many examples the learner holds."""
+    rows = []
+    for low, high in EXAMPLE_GROUPS:
+        mine = [r for r in records if r["examples"] >= low and (high is None or r["examples"] <= high)]
+        if not mine:
+            continue
+        best = [max(q[0] for q in r["instance"]) for r in mine if r["instance"]]
+        rows.append({"examples": f"{low}-{high}" if high else f"{low}+", "states": len(mine),
+                     "real_acd": float(np.mean([r["realised"][0] for r in mine])),
+                     "real_accuracy": float(np.mean([r["realised_accuracy"] for r in mine])),
+                     "best_instance_acd": float(np.mean(best)) if best else None})
+    return rows
