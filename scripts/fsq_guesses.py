@@ -8,7 +8,7 @@ where one label or demonstration question is at least as good as the real answer
 groups the real answer's one-step change by the examples the learner holds.
 Applies the file's rule and prints its verdict; --json ends with one JSON line.
 
-    .venv/bin/python scripts/fsq_guesses.py --data choice|confirmation [--json] [--datasets N] [--seeds N ...]
+    .venv/bin/python scripts/fsq_guesses.py --data choice|confirmation [--horizon] [--json] [--datasets N] [--seeds N ...]
 """
 
 from __future__ import annotations
@@ -22,7 +22,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from dialog.experiments.fsq_guesses import by_examples, dominated, guess_table  # noqa: E402
+from dialog.experiments.fsq_guesses import by_examples, dominated, guess_table, horizon_table  # noqa: E402
 from dialog.experiments.provenance import git_commit  # noqa: E402
 from dialog.experiments.whatif_calibration import calibration_specs, run_calibration  # noqa: E402
 from learning.datafiles import check_keys, integer, numbers, read_toml, texts  # noqa: E402
@@ -67,13 +67,16 @@ def main(argv=None) -> int:
     parser.add_argument("--datasets", type=int, default=None)
     parser.add_argument("--seeds", type=int, nargs="+", default=None)
     parser.add_argument("--workers", type=int, default=config["workers"])
+    parser.add_argument("--horizon", action="store_true",
+                        help="also read each guess over the examples the episode can still gather, against the real "
+                             "answer's change by the end of the episode")
     parser.add_argument("--json", action="store_true")
     args = parser.parse_args(argv)
     run = config["runs"][args.data]
     datasets, seeds = args.datasets or run["datasets"], args.seeds or run["seeds"]
     started = time.perf_counter()
     specs = calibration_specs(config["strategies"], run["data_seed"], datasets, seeds)
-    results = run_calibration(specs, args.workers, accuracy_what_if=False, feature_guesses=True)
+    results = run_calibration(specs, args.workers, accuracy_what_if=False, feature_guesses=True, horizon=args.horizon)
     records = [dict(r, strategy=res["strategy"]) for res in results for r in res["feature_guesses"]]
     rows = guess_table(records, config["guesses"])
     early = [r for r in records if r["turn"] <= 5]
@@ -101,11 +104,20 @@ def main(argv=None) -> int:
     for g in groups:
         best = "–" if g["best_instance_acd"] is None else f"{g['best_instance_acd']:+.4f}"
         print(f"| {g['examples']} | {g['states']} | {g['real_acd']:+.4f} | {g['real_accuracy']:+.4f} | {best} |")
+    horizon = horizon_table(records, config["guesses"]) if args.horizon else []
+    if horizon:
+        print("against the real answer's change by the end of the episode:")
+        print("| guess | reading | target | turns | n | mean predicted | mean realised | r | mean abs. error |")
+        print("|---|---|---|---|---:|---:|---:|---:|---:|")
+        for row in horizon:
+            r = "–" if row["correlation"] is None else f"{row['correlation']:.2f}"
+            print(f"| {row['guess']} | {row['reading']} | {SHORT[row['target']]} | {row['turns']} | {row['n']} | "
+                  f"{row['predicted']:+.4f} | {row['realised']:+.4f} | {r} | {row['mae']:.4f} |")
     print("rule (lower MAE than", config["baseline"], "on", ", ".join(SHORT[t] for t in config["targets"]) + "):",
           ", ".join(better) or "no guess passes")
     if args.json:
         print(json.dumps({"data": args.data, "data_seed": run["data_seed"], "datasets": datasets, "seeds": seeds,
-                          "commit": git_commit(), "rows": rows, "counts": counts, "by_examples": groups, "better": better,
+                          "commit": git_commit(), "rows": rows, "counts": counts, "by_examples": groups, "horizon": horizon, "better": better,
                           "per_strategy_states": {s: sum(r["strategy"] == s for r in records)
                                                   for s in config["strategies"]}}))
     return 0

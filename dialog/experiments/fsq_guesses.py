@@ -7,6 +7,10 @@ without changing the episode:
   phi_L(s), and of held-out accuracy, every answer refit exactly (``refit_probabilities``);
 * the change the teacher's real answer (the task's relevant features, what the scripted teacher says with
   feature quality 1) would make, refit the same way: the "realised" change, the target every guess is judged by;
+* with ``horizon``, the same guesses read over the examples the episode can still gather (the training set
+  repeated to n + m examples, m the instance questions the budget and the clock still allow after the FSQ: the
+  future examples assumed like the past ones) against the change the real answer makes on the episode's final
+  training set, read on the same scene: what the answer is worth by the end, which one step does not see;
 * every label and demonstration question's expected change of the learning features (the fast what-if of eq. 7.1),
   to count the states where one instance question is at least as good as the real answer on every learning
   feature: there no weights with the thesis's signs (every learning feature weighed >= 0, the FSQ's higher cost
@@ -32,29 +36,39 @@ def _accuracy(P: np.ndarray, concepts, truth) -> float:
     return accuracy(np.array(concepts, dtype=object)[np.argmax(P, axis=-1)], truth)
 
 
-def answer_effect(state, answers, test_X, test_y) -> tuple[np.ndarray, float]:
-    """E[(phi_L, held-out accuracy)] over ``answers`` (probability, subsets), each refit exactly; with no answer
-    the FSQ changes nothing and the current values come back."""
+def answer_effect(state, answers, test_X, test_y, training=None, scene=None, scaler=None) -> tuple[np.ndarray, float]:
+    """E[(phi_L, held-out accuracy)] over ``answers`` (probability, subsets), each refit exactly on ``training``
+    (default the state's) and read on ``scene`` (default the state's); with no answer, the current features'."""
+    X, labels = state.training_matrix() if training is None else training
+    scene = state.scene_X if scene is None else scene
     if not answers:
-        return learning_features(state.probabilities(), concept_counts(state))[:K], \
-            _accuracy(state.probabilities(test_X), state.concepts, test_y)
-    rows = np.vstack([state.scene_X, test_X])
-    counts, n = concept_counts(state), len(state.scene_X)
+        answers = [(1.0, dict(state.fitted_feature_subsets))]
+    rows = np.vstack([scene, test_X])
+    counts, n = np.array([sum(label == c for label in labels) for c in state.concepts], dtype=float), len(scene)
     phi, acc = np.zeros(K), 0.0
     for probability, subsets in answers:
-        P = refit_probabilities(state, subsets, rows)
+        P = refit_probabilities(state, subsets, rows, (X, labels), scaler)
         phi += probability * learning_features(P[:n], counts)[:K]
         acc += probability * _accuracy(P[n:], state.concepts, test_y)
     return phi, acc
 
 
+def examples_still_affordable(state) -> int:
+    """m: the label or demonstration questions the budget and the clock still allow once the FSQ is paid."""
+    progress = state.progress
+    cheapest = min(progress.costs["label"], progress.costs["demo"])
+    left = progress.remaining_budget - progress.costs["feature"]
+    return int(max(0, min(progress.turns - progress.turn - 1, left // cheapest if cheapest > 0 else left)))
+
+
 class FeatureGuessProbe:
     """A manager observer: one record per decision with the FSQ open and an example learned (module docstring)."""
 
-    def __init__(self, relevant_features, guesses=GUESSES):
-        self.relevant, self.guesses = tuple(relevant_features), tuple(guesses)
+    def __init__(self, relevant_features, guesses=GUESSES, horizon: bool = False):
+        self.relevant, self.guesses, self.horizon = tuple(relevant_features), tuple(guesses), horizon
         self.manager = None
         self.records: list[dict] = []
+        self._views: list[tuple] = []  # (scene, scaler, current subsets) of every record, for ``finish``
 
     def attach(self, manager) -> None:
         self.manager = manager
@@ -75,6 +89,8 @@ class FeatureGuessProbe:
         for guess in self.guesses:
             guess_phi, guess_acc = answer_effect(state, guessed_answers(state, guess), test_X, test_y)
             record["guesses"][guess] = {"predicted": (guess_phi - phi).tolist(), "predicted_accuracy": guess_acc - acc}
+        if self.horizon:
+            self._horizon(state, record, test_X, test_y)
         table = expected_decision_features(state)
         instance = [i for i, a in enumerate(table.actions) if a.kind in ("label", "demo")]
         record["instance"] = (table.expected[instance, :K] - phi).tolist()
@@ -82,6 +98,31 @@ class FeatureGuessProbe:
 
     def on_turn(self, record: dict, scene) -> None:
         pass
+
+    def _horizon(self, state, record, test_X, test_y) -> None:
+        X, labels = state.training_matrix()
+        m = examples_still_affordable(state)
+        copies = max(1, int(round((len(X) + m) / len(X))))
+        evidence = (np.repeat(X, copies, axis=0), [label for label in labels for _ in range(copies)])
+        base_phi, base_acc = answer_effect(state, [], test_X, test_y, evidence)
+        record["horizon"] = {"m": m, "copies": copies}
+        for guess in self.guesses:
+            phi, acc = answer_effect(state, guessed_answers(state, guess), test_X, test_y, evidence)
+            record["guesses"][guess]["horizon"] = (phi - base_phi).tolist()
+            record["guesses"][guess]["horizon_accuracy"] = acc - base_acc
+        self._views.append((record, state.scene_X, state.scaler, dict(state.fitted_feature_subsets)))
+
+    def finish(self, state) -> list[dict]:
+        """With ``horizon``: the real answer's change on the final training set, read on each record's scene."""
+        test_X, test_y = self.manager._test
+        final = state.training_matrix()
+        teacher = np.array(sorted(list(state.feature_names).index(name) for name in self.relevant))
+        for record, scene, scaler, current in self._views:
+            phi0, acc0 = answer_effect(state, [(1.0, current)], test_X, test_y, final, scene, scaler)
+            phi1, acc1 = answer_effect(state, [(1.0, {c: teacher for c in state.concepts})], test_X, test_y,
+                                       final, scene, scaler)
+            record["realised_by_end"], record["realised_accuracy_by_end"] = (phi1 - phi0).tolist(), acc1 - acc0
+        return self.records
 
 
 def dominated(record: dict, predicted: list[float] | None = None) -> bool:
@@ -130,4 +171,28 @@ def by_examples(records: list[dict]) -> list[dict]:
                      "real_acd": float(np.mean([r["realised"][0] for r in mine])),
                      "real_accuracy": float(np.mean([r["realised_accuracy"] for r in mine])),
                      "best_instance_acd": float(np.mean(best)) if best else None})
+    return rows
+
+
+def horizon_table(records: list[dict], guesses=GUESSES) -> list[dict]:
+    """Per guess, reading (one step, or over the examples still to come) and target (ACD, accuracy): the mean
+    prediction against the real answer's change by the end of the episode, r, mean absolute error; all turns and
+    turns 1-5."""
+    rows = []
+    for guess in guesses:
+        for reading, key in (("one step", "predicted"), ("horizon", "horizon")):
+            for target in ("classifier_discriminability", "accuracy"):
+                for turns, mine in (("all", records), ("1-5", [r for r in records if r["turn"] <= 5])):
+                    if not mine:
+                        continue
+                    if target == "accuracy":
+                        p = np.array([r["guesses"][guess][f"{key}_accuracy"] for r in mine])
+                        q = np.array([r["realised_accuracy_by_end"] for r in mine])
+                    else:
+                        p = np.array([r["guesses"][guess][key][0] for r in mine])
+                        q = np.array([r["realised_by_end"][0] for r in mine])
+                    r = float(np.corrcoef(p, q)[0, 1]) if len(p) > 1 and p.std() > 0 and q.std() > 0 else None
+                    rows.append({"guess": guess, "reading": reading, "target": target, "turns": turns, "n": len(p),
+                                 "predicted": float(p.mean()), "realised": float(q.mean()), "correlation": r,
+                                 "mae": float(np.abs(p - q).mean())})
     return rows

@@ -123,6 +123,7 @@ class CalibrationTask:
     accuracy_what_if: bool = True
     record: bool = True  # False: the same episode without the recorder (the test that it changes nothing)
     feature_guesses: bool = False  # also probe the FSQ's guessed answers (dialog.experiments.fsq_guesses)
+    horizon: bool = False  # ... and read them over the examples the episode can still gather
 
 
 def play(task: CalibrationTask) -> dict:
@@ -149,7 +150,7 @@ def play(task: CalibrationTask) -> dict:
         if task.feature_guesses:
             from dialog.experiments.fsq_guesses import FeatureGuessProbe
 
-            probe = FeatureGuessProbe(pools.task.relevant_features)
+            probe = FeatureGuessProbe(pools.task.relevant_features, horizon=task.horizon)
             observers += (probe,)
         with TranscriptWriter(str(Path(scratch) / "episode.jsonl")) as transcript:
             manager = build_episode(settings, environment, teacher, transcript, strategy=strategy, rngs=rngs,
@@ -160,7 +161,7 @@ def play(task: CalibrationTask) -> dict:
             result = manager.run()
     return {"strategy": spec.strategy, "dataset": spec.dataset, "seed": spec.seed, "accuracy": result.accuracy,
             "records": recorder.finish(result.accuracy) if task.record else [], "quiet_turns": recorder.quiet_turns,
-            "actions": actions, "feature_guesses": probe.records if task.feature_guesses else []}
+            "actions": actions, "feature_guesses": probe.finish(manager.state) if task.feature_guesses else []}
 
 
 def calibration_specs(strategies, data_seed: int, datasets: int, seeds, turns: int | None = None,
@@ -175,9 +176,9 @@ def calibration_specs(strategies, data_seed: int, datasets: int, seeds, turns: i
 
 
 def run_calibration(specs: list[EpisodeSpec], workers: int = 2, accuracy_what_if: bool = True,
-                    feature_guesses: bool = False) -> list[dict]:
+                    feature_guesses: bool = False, horizon: bool = False) -> list[dict]:
     """Play every spec with the recorder (and the FSQ-guess probe), on ``workers`` processes; results in spec order."""
-    tasks = [CalibrationTask(spec, accuracy_what_if, feature_guesses=feature_guesses) for spec in specs]
+    tasks = [CalibrationTask(spec, accuracy_what_if, feature_guesses=feature_guesses, horizon=horizon) for spec in specs]
     if workers == 1 or len(tasks) == 1:
         return [play(task) for task in tasks]
     with ProcessPoolExecutor(workers) as pool:

@@ -59,9 +59,11 @@ def guessed_answers(state, guess: str) -> list[Answer]:
     return [(1.0, {c: subsets[c] if made[c] else current[c] for c in concepts})]
 
 
-def refit_probabilities(state, subsets, rows: np.ndarray) -> np.ndarray:
-    """p(y|x) of raw ``rows`` after refitting every classifier from scratch on the training set with ``subsets``
-    (the learner's own ``ConceptModels``, as the reference what-if engine refits); the state is not changed."""
-    X, labels = state.scaled_training()
+def refit_probabilities(state, subsets, rows: np.ndarray, training: tuple | None = None, scaler=None) -> np.ndarray:
+    """p(y|x) of raw ``rows`` after refitting every classifier from scratch with ``subsets`` (the learner's own
+    ``ConceptModels``, as the reference what-if engine refits) on the training set, or on ``training`` = (raw X,
+    labels) if given, scaled by ``scaler`` (default the state's); the state is not changed."""
+    scaler = state.scaler if scaler is None else scaler
+    X, labels = state.training_matrix() if training is None else training
     models = ConceptModels(state.concepts, variance=state.kernel_variance, length_scale=state.length_scale)
-    return models.fit(X, labels, subsets).predict(state.scaler.transform(rows))
+    return models.fit(scaler.transform(X), labels, subsets).predict(scaler.transform(rows))

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from dialog.experiments.fsq_guesses import TARGETS, dominated, guess_table
+from dialog.experiments.fsq_guesses import TARGETS, dominated, guess_table, horizon_table
 from dialog.experiments.whatif_calibration import CalibrationTask, calibration_specs, play
 from learning.whatif.feature_guesses import GUESSES
 
@@ -13,7 +13,7 @@ SMALL = (("objects_per_scene", 8), ("pool_size", 24), ("test_size", 16))
 @pytest.fixture(scope="module")
 def episodes():
     spec = calibration_specs(["dt-task-env"], 101, 1, [41], turns=8, plan=SMALL)[0]
-    return (play(CalibrationTask(spec, accuracy_what_if=False, feature_guesses=True)),
+    return (play(CalibrationTask(spec, accuracy_what_if=False, feature_guesses=True, horizon=True)),
             play(CalibrationTask(spec, accuracy_what_if=False, record=False)))
 
 
@@ -42,3 +42,15 @@ def test_the_table_is_the_records_means(episodes):
     p = np.array([r["guesses"]["union"]["predicted_accuracy"] for r in records])
     q = np.array([r["realised_accuracy"] for r in records])
     assert row["mae"] == pytest.approx(np.abs(p - q).mean()) and row["n"] == len(records)
+
+
+def test_the_horizon_reads_the_same_guesses_over_more_evidence_and_the_end(episodes):
+    records = episodes[0]["feature_guesses"]
+    for r in records:
+        assert r["horizon"]["copies"] >= 1 and 0 <= r["horizon"]["m"] <= 8
+        assert len(r["realised_by_end"]) == 4 and -1 <= r["realised_accuracy_by_end"] <= 1
+        for guess in GUESSES:
+            assert len(r["guesses"][guess]["horizon"]) == 4
+    rows = horizon_table(records)
+    assert {row["reading"] for row in rows} == {"one step", "horizon"}
+    assert all(row["n"] <= len(records) for row in rows)
