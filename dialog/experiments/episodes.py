@@ -96,7 +96,7 @@ def _run_episode(spec: EpisodeSpec, strategy: Strategy | None = None) -> dict:
     if condition.seconds is not None:  # embodied costs: the scenes come with time (dialog/embodied.py)
         scenes = max(1, int(-(-condition.seconds // load_embodied_costs().scene_seconds(condition.change_every))))
     environment = PoolEnvironment(pools.train[spec.dataset], pools.test, pools.task, scenes,
-                                  condition.objects_per_scene)
+                                  condition.objects_per_scene, condition.state_schedule)
     settings = spec.settings()
     rngs = episode_generators(settings.seed)
     timing = embodied_timing(condition.seconds)

@@ -6,11 +6,11 @@ held-out test pool. The pools are the simulator's cached data sets
 (:func:`bullet_world.datasets.load_datasets`, with the Panda attached so its
 features are in every row).
 
-Groundings that change over time (prepare-lunch, thesis §6.6.2) follow the
-episode's clock: a kind with states in order (pasta boxed -> in a pot -> in a
-bowl) is drawn in the state that matches how far the episode has gone, so the
-main dish the robot sees early looks unlike the one it sees late, while the
-test pool keeps every state.
+Groundings that change over time (prepare-lunch, thesis §6.6.2) follow one of two schedules
+(docs/open-settings.md): ``per-scene``, the thesis's §6.5.3 sampling, draws every object of a new scene from
+all rows of its concept, every state as the data set holds it; ``episode-clock`` draws a kind with states in
+order (pasta boxed -> in a pot -> in a bowl) in the state that matches how far the episode has gone, so the
+main dish the robot sees early looks unlike the one it sees late. The test pool keeps every state either way.
 """
 
 from __future__ import annotations
@@ -23,6 +23,7 @@ import numpy as np
 from bullet_world.catalogue import Task, load_task
 from bullet_world.datasets import Pool, load_datasets
 from bullet_world.scene import Scene, SceneTruth
+from dialog.experiments.suite import STATE_SCHEDULES
 from learning.errors import SettingsError
 from learning.limits import check_limit
 
@@ -103,7 +104,7 @@ class PoolEnvironment:
     """The manager's environment over a training pool and a test pool (no arm: nothing to point with)."""
 
     def __init__(self, train: Pool, test: Pool, task: Task, scenes_per_episode: int = 1,
-                 objects_per_scene: int | None = None):
+                 objects_per_scene: int | None = None, state_schedule: str = "episode-clock"):
         concepts = task.concepts
         missing = sorted(set(concepts) - set(train.concepts.tolist()))
         if missing:
@@ -112,6 +113,10 @@ class PoolEnvironment:
         if not 1 <= size <= task.max_objects_per_scene:
             raise SettingsError(f"objects_per_scene {size} is not accepted for task '{task.name}': a scene holds "
                                 f"1 to {task.max_objects_per_scene} objects")
+        if state_schedule not in STATE_SCHEDULES:
+            raise SettingsError(f"state schedule {state_schedule!r} is not accepted; choose one of "
+                                f"{', '.join(STATE_SCHEDULES)}")
+        self.state_schedule = state_schedule
         self.train, self.test = train, test
         self.concepts = tuple(concepts)
         self.feature_names = tuple(train.feature_names)
@@ -133,10 +138,11 @@ class PoolEnvironment:
         return stages
 
     def _rows_now(self, concept: str, progress: float) -> np.ndarray:
-        """Rows of ``concept`` whose state matches the episode's progress (all rows of stateless kinds)."""
+        """Rows of ``concept`` whose state matches the episode's progress (all rows of stateless kinds); every row
+        with the ``per-scene`` schedule."""
         rows = self._by_concept[concept]
         stages = self._stage_of_row[rows]
-        if (stages < 0).all():
+        if self.state_schedule == "per-scene" or (stages < 0).all():
             return rows
         # a row's state spans [stage, stage + 1/len(states)); pick the latest state begun by now
         begun = rows[(stages >= 0) & (stages <= progress)]

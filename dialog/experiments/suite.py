@@ -24,14 +24,18 @@ KINDS = ("episodes", "feature-selection", "recipes")
 AXES = ("questions", "turns", "demonstrations", "seconds")
 SUITE_FIELDS = ("name", "description", "analysis", "kind", "task", "kitchen", "strategies", "datasets", "seeds",
                 "checkpoints", "axis", "costs", "teacher", "options", "dataset", "data_seed", "condition", "finding",
-                "objects_per_scene")
+                "objects_per_scene", "state_schedule")
 # a suite that extends another (issue 39's pre-registered run): the other's suite with more strategies and findings
 EXTENSION_FIELDS = ("extends", "name", "description", "analysis", "add_strategies", "finding")
 CONDITION_FIELDS = ("name", "budget", "turns", "change_every")
 # seconds: embodied costs' time allocation (turns is then the cap); objects_per_scene: the scene size (thesis §6.5)
 # teacher: the scripted teacher's options for this condition, over the suite's [teacher] (a sweep of them)
 # until_budget_spent: the thesis's chapter-6 ending (the episode ends once the budget is spent; turns is the bound)
-CONDITION_OPTIONAL = ("seconds", "objects_per_scene", "teacher", "until_budget_spent")
+# When an object with ordered states (prepare-lunch's pasta) is in which state (docs/open-settings.md): drawn in
+# the state matching the share of the allocation's scenes already shown, or at random at every new scene.
+STATE_SCHEDULES = ("episode-clock", "per-scene")
+# state_schedule: when a prepare-lunch object is in which state (docs/open-settings.md; dialog.experiments.pools)
+CONDITION_OPTIONAL = ("seconds", "objects_per_scene", "teacher", "until_budget_spent", "state_schedule")
 FINDING_FIELDS = ("id", "text", "condition", "at", "better", "than", "alternative", "than_at", "margin")
 TEACHER_KINDS = ("scripted", "oracle")
 TEACHER_RATES = ("mislabel_rate", "dont_know_rate", "feature_quality", "feature_recall", "feature_noise",
@@ -55,6 +59,7 @@ class Condition:
     objects_per_scene: int | None = None  # scene size of the episodes (None: the task's interactive default)
     teacher: tuple = ()  # ((option, value), ...): the scripted teacher's options here, over the suite's [teacher]
     until_budget_spent: bool = False  # end once the budget is spent (thesis ch. 6); ``turns`` is the safety bound
+    state_schedule: str = "episode-clock"  # or "per-scene" (docs/open-settings.md; dialog.experiments.pools)
 
     def scene_size(self, task_default: int) -> int:
         """How many objects each scene of this condition holds."""
@@ -218,7 +223,8 @@ def _suite(table: dict, where: str, known_strategies) -> Suite:
             raise SuiteError(f"{where}: unknown strategies {unknown}; known: {', '.join(known_strategies)}, "
                              f"{RL_PREFIX}FILE (a trained questioner policy) or {PLUGIN_FORM}")
     scene_size = integer(table, "objects_per_scene", where, None, low=1)
-    conditions = tuple(_condition(c, f"{where} condition {i + 1}", scene_size)
+    schedule = text(table, "state_schedule", where, STATE_SCHEDULES[0], choices=STATE_SCHEDULES)
+    conditions = tuple(_condition(c, f"{where} condition {i + 1}", scene_size, schedule)
                        for i, c in enumerate(tables(table, "condition", where, [])))
     if kind == "episodes" and not conditions:
         raise SuiteError(f"{where}: an episodes suite needs at least one [[condition]]")
@@ -253,8 +259,10 @@ def _suite(table: dict, where: str, known_strategies) -> Suite:
     )
 
 
-def _condition(table: dict, where: str, objects_per_scene: int | None = None) -> Condition:
-    """One [[condition]]; ``objects_per_scene`` is the suite's scene size, which a condition may override."""
+def _condition(table: dict, where: str, objects_per_scene: int | None = None,
+               state_schedule: str = "episode-clock") -> Condition:
+    """One [[condition]]; ``objects_per_scene`` and ``state_schedule`` are the suite's, which a condition may
+    override."""
     check_keys(table, where, required=CONDITION_FIELDS, optional=CONDITION_OPTIONAL)
     return Condition(datafiles.name(table, "name", where, what="condition name"),
                      number(table, "budget", where, low=0.0, high=maximum("budget")),
@@ -262,7 +270,8 @@ def _condition(table: dict, where: str, objects_per_scene: int | None = None) ->
                      integer(table, "change_every", where, low=1),
                      number(table, "seconds", where, None, above=0.0, high=maximum("seconds")),
                      integer(table, "objects_per_scene", where, objects_per_scene, low=1),
-                     tuple(sorted(_teacher(table, where).items())), _until_budget_spent(table, where))
+                     tuple(sorted(_teacher(table, where).items())), _until_budget_spent(table, where),
+                     text(table, "state_schedule", where, state_schedule, choices=STATE_SCHEDULES))
 
 
 def _until_budget_spent(table: dict, where: str) -> bool:

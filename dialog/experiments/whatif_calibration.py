@@ -133,7 +133,7 @@ def play(task: CalibrationTask) -> dict:
         pools = load_pools(spec.task, spec.kitchen, spec.dataset + 1, spec.plan, data_seed=spec.data_seed)
         c = spec.condition
         environment = PoolEnvironment(pools.train[spec.dataset], pools.test, pools.task,
-                                      -(-c.turns // max(c.change_every, 1)), c.objects_per_scene)
+                                      -(-c.turns // max(c.change_every, 1)), c.objects_per_scene, c.state_schedule)
         settings = spec.settings()
         rngs = episode_generators(settings.seed)
         timing = embodied_timing(c.seconds)  # as dialog.experiments.episodes builds an episode
