@@ -44,7 +44,8 @@ def test_the_committed_rule_calibrates_dt_iros_and_dt_task_on_data_no_table_uses
         ("dt-iros", "dt-iros-v1", "class_distribution_uniformity"),
         ("dt-task", "dt-task-v1", "class_distribution_uniformity")]
     assert all(seed >= 100 for seed in rule.data_seeds)
-    assert rule.episodes == 2 * 4 * 3 * len(rule.data_seeds) * rule.datasets * len(rule.seeds)
+    assert rule.episodes == 2 * 6 * 3 * len(rule.data_seeds) * rule.datasets * len(rule.seeds)  # issue 53: 6 values
+    assert all(0.05 < max(p.grid) for p in rule.presets)  # the grid brackets the first run's choice
     assert all(s.data_seed >= 100 and all(c.until_budget_spent for c in s.conditions) for s in plan_suites(rule))
 
 
