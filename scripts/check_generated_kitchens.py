@@ -29,6 +29,7 @@ sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "scripts"))
 
 from bench_pick_place import Bench  # noqa: E402
+
 from bullet_world.check import scene_errors, timed_scene  # noqa: E402
 from bullet_world.datafiles import available  # noqa: E402
 from bullet_world.generation import generate_kitchens  # noqa: E402
@@ -161,7 +162,8 @@ def main(argv: list[str] | None = None) -> int:
                                      and row["loc_err_mm"]["median"] <= BAND_MEDIAN_MM
                                      and row["size_err_mm"]["p95"] <= bands["size_p95_mm"]
                                      and row["loc_err_mm"]["p95"] <= bands["loc_p95_mm"] for row in rows),
-        "perception_within_bands": bool(size_all["median"] <= BAND_MEDIAN_MM and location_all["median"] <= BAND_MEDIAN_MM
+        "perception_within_bands": bool(size_all["median"] <= BAND_MEDIAN_MM
+                                        and location_all["median"] <= BAND_MEDIAN_MM
                                         and size_all["p95"] <= bands["size_p95_mm"]
                                         and location_all["p95"] <= bands["loc_p95_mm"]),
         "pointing": {"objects": pointed, "missed": missed, "touched": touched},

@@ -44,7 +44,7 @@ def _sink(name: str, centre_xy, tap_xy, distributions: Distributions, parts: dic
 def draw_furniture(layout: Layout, distributions: Distributions, parts: dict, rng: np.random.Generator) -> list:
     """Every [[furniture]] piece of the layout's family, in a fixed order."""
     family, runs, worktop = layout.family, distributions.runs, distributions.worktop
-    thickness, floor = worktop["thickness"], -layout.worktop_height
+    floor = -layout.worktop_height
     half_length, half_depth = layout.length / 2, layout.depth / 2
     base_x, base_y = layout.base
     width, depth = worktop["pedestal"]
