@@ -162,7 +162,7 @@ def load_datasets(task: str, kitchen: str = "kitchen-1", seed: int = 0, plan: Da
     plan = plan or load_task(task).datasets
     key = generator_hash(task, kitchen, plan, seed, robot_factory is not None)
     folder = cache_dir(cache) / "datasets"
-    stem = f"{task}-{kitchen}-seed{seed}-{key}"
+    stem = f"{_file_label(task)}-{_file_label(kitchen)}-seed{seed}-{key}"
     npz_path, json_path = folder / f"{stem}.npz", folder / f"{stem}.json"
     cached = None if rebuild else _cached(npz_path, json_path, progress)
     if cached is not None:
@@ -175,6 +175,12 @@ def load_datasets(task: str, kitchen: str = "kitchen-1", seed: int = 0, plan: Da
         datasets = replace(datasets, metadata=datasets.metadata | {"generator": key, "file": str(npz_path)})
         _save(datasets, npz_path, json_path)
     return datasets
+
+
+def _file_label(name_or_path: str) -> str:
+    """A task's or kitchen's name as part of a cache file's name: a .toml path by its file's stem (the key
+    hashes the file's bytes), so a path never makes folders in the cache."""
+    return Path(name_or_path).stem if str(name_or_path).endswith(".toml") else str(name_or_path)
 
 
 def _cached(npz_path: Path, json_path: Path, progress=None) -> TaskDatasets | None:

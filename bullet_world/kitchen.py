@@ -66,6 +66,9 @@ class Kitchen:
     ambient_noise: dict = field(default_factory=dict)
     room: Room | None = None             # None: a bare counter (no floor, cabinets or fixtures)
     fixtures: dict[str, Fixture] = field(default_factory=dict)   # location name -> what it is built as
+    households: dict[str, tuple[dict, ...]] = field(default_factory=dict)  # task -> the dishes its recipes use
+    generated: dict = field(default_factory=dict)   # a generated kitchen's seed, family and distributions
+    path: str = ""                       # the file it was read from
 
     def lies_on_worktop(self, piece: Piece) -> bool:
         """A flat piece on the worktop (a fixture's top, a burner, a sink): no thicker than the worktop, its top
@@ -189,7 +192,8 @@ def load_kitchen(name_or_path) -> Kitchen:
     table = read_toml(path, "kitchen")
     where = str(path)
     check_keys(table, where, required=("name", "counter", "robot", "object_region", "camera", "lighting", "locations"),
-               optional=("description", "ambient_noise", "materials", "room", "furniture"))
+               optional=("description", "ambient_noise", "materials", "room", "furniture", "households",
+                         "generated"))
     section = {key: table_section(table, key, where) for key in
                ("counter", "robot", "object_region", "camera", "lighting", "locations")}
     counter, robot = section["counter"], section["robot"]
@@ -209,12 +213,16 @@ def load_kitchen(name_or_path) -> Kitchen:
         ambient_noise=_ambient_noise(table_section(table, "ambient_noise", where, {}), f"{where} [ambient_noise]"),
         locations={name: _location(name, entry, f"{where} [locations.{name}]")
                    for name, entry in section["locations"].items()},
+        generated=_generated(table_section(table, "generated", where, {}), f"{where} [generated]"),
+        path=where,
     )
     missing = [name for name in INTEREST_POINTS if name not in kitchen.locations]
     if missing:
         raise DataFileError(f"{where} [locations]: every kitchen needs the interest points "
                             f"{', '.join(INTEREST_POINTS)}; missing {', '.join(missing)}")
     kitchen = _furnish(kitchen, table, where)
+    kitchen = replace(kitchen, households=_households(table_section(table, "households", where, {}), where,
+                                                      kitchen.locations))
     base = np.asarray(kitchen.robot_base[:2])
     for location in kitchen.locations.values():
         distance = float(np.linalg.norm(np.asarray(location.centre[:2]) - base))
@@ -254,3 +262,41 @@ def _furnish(kitchen: Kitchen, table: dict, where: str) -> Kitchen:
                                 f"([object_region]); only pieces flush with the worktop (top <= {FLUSH_M} m) may "
                                 f"stand there")
     return replace(kitchen, room=room, fixtures=fixtures)
+
+
+def _generated(table: dict, where: str) -> dict:
+    """``[generated]``: where a generated kitchen came from (``teachbot world generate``)."""
+    if not table:
+        return {}
+    check_keys(table, where, required=("seed", "family", "distributions", "sha256"))
+    sha = text(table, "sha256", where)
+    if len(sha) != 64 or any(c not in "0123456789abcdef" for c in sha):
+        raise DataFileError(f"{where}: 'sha256' must be 64 lowercase hex digits, got {sha!r}")
+    return {"seed": integer(table, "seed", where, low=0), "family": text(table, "family", where),
+            "distributions": text(table, "distributions", where), "sha256": sha}
+
+
+def _households(table: dict, where: str, locations: dict) -> dict[str, tuple[dict, ...]]:
+    """``[households.TASK]``: ``objects`` = [{ kind, role (optional), at }], each "at" one of the kitchen's
+    locations or "elsewhere"; the kinds are checked against the task when a recipe uses them."""
+    from bullet_world.datafiles import available
+
+    households = {}
+    places = (*locations, "elsewhere")
+    for task, entry in table.items():
+        at = f"{where} [households.{task}]"
+        if task not in available("tasks"):
+            raise DataFileError(f"{at}: no task '{task}'; tasks: {', '.join(available('tasks'))}")
+        check_keys(entry, at, required=("objects",))
+        objects = entry["objects"]
+        if not isinstance(objects, list) or not objects or not all(isinstance(item, dict) for item in objects):
+            raise DataFileError(f"{at}: 'objects' must be a non-empty list of {{ kind, role, at }} tables, "
+                                f"got {objects!r}")
+        for index, item in enumerate(objects, 1):
+            here = f"{at} object {index}"
+            check_keys(item, here, required=("kind", "at"), optional=("role",))
+            text(item, "kind", here)
+            text(item, "role", here, "")
+            text(item, "at", here, choices=places)
+        households[task] = tuple(objects)
+    return households

@@ -3,6 +3,7 @@
     python scripts/fuzz_files.py --cases 300 --json
 
 Kinds: the study file, a suite, DT weights, a questioner policy (its TOML and its NPZ), a kitchen and a task file,
+the kitchen generator's data file and a kitchen it generated,
 a teach transcript (resumed, and given to a replay teacher with --replay, also as a link to /dev/zero or a
 FIFO), a study session's transcript (torn or answer-less beside its questionnaire, headers edited), its
 questionnaire answers (lone surrogates in text) and an abort note, IRL demonstrations, and hostile output
@@ -85,6 +86,11 @@ def make_kinds(conditions) -> list[Kind]:
         Kind("policy-npz", "policy", "q.npz", [[*demo, "--strategy", "rl:q.toml"]], [], byte_rules=True),
         Kind("kitchen", "world", "kitchen.toml", [["world", "show", "--kitchen", "kitchen.toml"]], toml_rules()),
         Kind("task", "world", "task.toml", [["world", "show", "--task", "task.toml"]], toml_rules()),
+        # issue 52: the kitchen generator's data file, and a kitchen it wrote
+        Kind("generator", "generator", "kitchens.toml",
+             [["world", "generate", "--seed", "7", "--out", "out", "--distributions", "kitchens.toml"]], toml_rules()),
+        Kind("generated-kitchen", "generated", "generated-7.toml",
+             [["world", "show", "--kitchen", "generated-7.toml"]], toml_rules()),
         Kind("transcript", "teach", "t.jsonl", [["teach", "--resume", "t.jsonl", "--no-pictures"]],
              kinds.TRANSCRIPT_RULES, recorded="t.jsonl*"),
         Kind("replay", "teach", "t.jsonl", [["teach", "--teacher", "replay", "--replay", "t.jsonl", "--turns", "4",
@@ -207,7 +213,7 @@ class Fuzzer:
     def setup(self) -> list[Kind]:
         """The good files every case starts from, made by teachbot itself."""
         base = self.base
-        for name in ("study", "suite", "weights", "policy", "world", "teach", "demos"):
+        for name in ("study", "suite", "weights", "policy", "world", "teach", "demos", "generator", "generated"):
             (base / name).mkdir(parents=True)
         text = (ROOT / "dialog/data/studies/example.toml").read_text(encoding="utf-8")
         text = re.sub(r"^turns = \d+", "turns = 3", text, flags=re.M).replace("participants = 6 ", "participants = 2 ")
@@ -224,6 +230,8 @@ class Fuzzer:
         shutil.copy(policy.with_suffix(".npz"), base / "policy/q.npz")
         shutil.copy(ROOT / "bullet_world/data/kitchens/kitchen-1.toml", base / "world/kitchen.toml")
         shutil.copy(ROOT / "bullet_world/data/tasks/pack-lunchbox.toml", base / "world/task.toml")
+        shutil.copy(ROOT / "bullet_world/data/generator/kitchens.toml", base / "generator/kitchens.toml")
+        self._must(["world", "generate", "--seed", "7", "--out", "."], base / "generated")
         self._must(["teach", "--teacher", "scripted", "--turns", "4", "--no-pictures", "--transcript", "t.jsonl"],
                    base / "teach")
         shutil.copy(sorted((ROOT / "learning/irl/expert-demos").glob("*.json"))[0], base / "demos/d.json")

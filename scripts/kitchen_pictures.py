@@ -10,6 +10,9 @@ no Chromium), each kitchen's 3D view as the meshcat mirror shows it (``docs/img/
 scripts/web_screenshot.py: a real ``teach --web`` session).
 
     .venv/bin/python scripts/kitchen_pictures.py [--seed 0] [--out docs/img/kitchens] [--no-page] [--json]
+
+``--kitchen FILE`` (repeatable) draws those kitchens instead of the shipped three (generated ones, say: the
+gallery of docs/kitchen.md#generated-kitchens), named by their file's stem; the teaching page is then left alone.
 """
 
 from __future__ import annotations
@@ -52,17 +55,26 @@ def room_view(world: World) -> np.ndarray:
     return np.asarray(rgba, dtype=np.uint8).reshape(height, width, 4)[:, :, :3]
 
 
+def _shown(path: Path) -> str:
+    path = path.resolve()
+    return str(path.relative_to(ROOT)) if path.is_relative_to(ROOT) else str(path)
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--out", type=Path, default=ROOT / "docs" / "img" / "kitchens")
     parser.add_argument("--no-page", action="store_true", help="not the teaching page's picture")
+    parser.add_argument("--kitchen", action="append", default=None, metavar="FILE",
+                        help="a kitchen file to draw instead of the shipped three (repeatable)")
     parser.add_argument("--json", action="store_true")
     args = parser.parse_args(argv)
+    kitchens = {Path(path).stem: path for path in args.kitchen} if args.kitchen else {
+        name: name for name in available("kitchens")}
     args.out.mkdir(parents=True, exist_ok=True)
     written = []
-    for name in available("kitchens"):
-        with World(kitchen=name, seed=args.seed) as world:
+    for name, kitchen in kitchens.items():
+        with World(kitchen=kitchen, seed=args.seed) as world:
             Arm(world)
             scene = world.new_scene(np.random.default_rng(args.seed))
             camera = annotate(world.images, scene, world.kitchen, scale=2)
@@ -70,7 +82,7 @@ def main(argv: list[str] | None = None) -> int:
             for kind, picture in (("camera", camera), ("room", room_view(world))):
                 path = args.out / f"{name}-{kind}.png"
                 write_png(path, picture)
-                written.append({"kitchen": name, "picture": kind, "path": str(path.relative_to(ROOT)),
+                written.append({"kitchen": name, "picture": kind, "path": _shown(path),
                                 "bytes": path.stat().st_size})
     page = ROOT / "docs" / "img" / "web-teach.png"
     if not args.no_page:
@@ -79,17 +91,18 @@ def main(argv: list[str] | None = None) -> int:
         if find_chromium() is None:
             print("no Chromium (apt-get install -y chromium): the page's picture is left as it is", file=sys.stderr)
         else:
-            for name in available("kitchens"):
+            for name, kitchen in kitchens.items():
                 path = args.out / f"{name}-3d.png"
-                subprocess.run([str(Path(sys.executable).with_name("teachbot")), "view", "--kitchen", name, "--seed",
+                subprocess.run([str(Path(sys.executable).with_name("teachbot")), "view", "--kitchen", kitchen, "--seed",
                                 str(args.seed), "--screenshot", str(path)], check=True, stdout=subprocess.DEVNULL)
                 picture = cv2.imread(str(path))
                 write_png(path, cv2.resize(picture, None, fx=0.75, fy=0.75, interpolation=cv2.INTER_AREA))
-                written.append({"kitchen": name, "picture": "3d", "path": str(path.relative_to(ROOT)),
+                written.append({"kitchen": name, "picture": "3d", "path": _shown(path),
                                 "bytes": path.stat().st_size})
-            subprocess.run([sys.executable, str(ROOT / "scripts" / "web_screenshot.py"), str(page)], check=True)
-            written.append({"kitchen": None, "picture": "page", "path": str(page.relative_to(ROOT)),
-                            "bytes": page.stat().st_size})
+            if not args.kitchen:
+                subprocess.run([sys.executable, str(ROOT / "scripts" / "web_screenshot.py"), str(page)], check=True)
+                written.append({"kitchen": None, "picture": "page", "path": str(page.relative_to(ROOT)),
+                                "bytes": page.stat().st_size})
     for entry in written:
         print(f"{entry['path']}: {entry['bytes'] / 1024:.0f} KB")
     if args.json:

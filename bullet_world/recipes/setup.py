@@ -61,11 +61,19 @@ class RecipeSceneSetup:
     settle_steps: int
     lighting: dict[str, Lighting]
     households: tuple[Household, ...]
+    kinds: frozenset[str] = frozenset()   # the kinds the task's object file has
 
-    def household_for(self, kitchen: str) -> Household:
-        """The household that lives in ``kitchen`` (the first one for a kitchen nobody lists)."""
+    def household_for(self, kitchen) -> Household:
+        """The household that lives in ``kitchen`` (a name or a :class:`Kitchen`): the kitchen's own
+        ``[households.TASK]`` when it carries one, else the one listing its name, else the first."""
+        carried = getattr(kitchen, "households", {}).get(self.task)
+        if carried is not None:
+            where = f"{kitchen.path} [households.{self.task}]"
+            entry = {"name": kitchen.name, "kitchens": [kitchen.name], "objects": list(carried)}
+            return _household(entry, where, set(self.kinds))
+        name = getattr(kitchen, "name", kitchen)
         for household in self.households:
-            if kitchen in household.kitchens:
+            if name in household.kitchens:
                 return household
         return self.households[0]
 
@@ -103,7 +111,7 @@ def load_recipe_setup(name_or_path: str | Path) -> RecipeSceneSetup:
         region_margin=numbers["region_margin"], min_gap=numbers["min_gap"], layouts=counts["layouts"],
         jitter_m=numbers["jitter_m"], yaw_jitter=numbers["yaw_jitter"],
         settle_steps=counts["settle_steps"], lighting=_lighting(_field(setup, "lighting", where, dict), where),
-        households=households,
+        households=households, kinds=frozenset(kind_names),
     )
 
 

@@ -104,7 +104,7 @@ class RecipeWorld:
     def _build(self, steps: Sequence[tuple[str, str, str]], seed: int) -> None:
         self.steps = tuple((str(o), str(s), str(e)) for o, s, e in steps)
         self.kitchen = self.world.kitchen
-        self.household = self.setup.household_for(self.kitchen.name)
+        self.household = self.setup.household_for(self.kitchen)
         roles = self.household.roles()
         for obj, start, _end in self.steps:
             if obj not in roles:

@@ -210,7 +210,8 @@ def add_kitchen_option(parser: argparse.ArgumentParser, default: str | None, def
     """``--kitchen NAME`` (or its number), the accepted names listed in --help; ``extra`` goes to add_argument."""
     numbers = ", ".join(name.removeprefix("kitchen-") for name in kitchen_names())
     parser.add_argument("--kitchen", default=default, type=kitchen_name, metavar="KITCHEN",
-                        help=f"kitchen: {', '.join(kitchen_names())}, or just its number ({numbers}) "
+                        help=f"kitchen: {', '.join(kitchen_names())}, or just its number ({numbers}), or a "
+                             f"kitchen .toml file (teachbot world generate writes them) "
                              f"(default {default_text or default})", **extra)
 
 

@@ -1,5 +1,6 @@
-"""``teachbot world show`` (an annotated camera picture) and ``teachbot world check`` (perception
-against the simulator's ground truth)."""
+"""``teachbot world show`` (an annotated camera picture), ``teachbot world check`` (perception against the
+simulator's ground truth), ``world data`` (a task's data sets) and ``world generate`` (kitchens drawn from a
+seed)."""
 
 from __future__ import annotations
 
@@ -74,6 +75,21 @@ def register(commands) -> None:
                       help="objects in the test pool (default: the task's [datasets] plan)")
     data.add_argument("--json", action="store_true", help="end with one JSON line")
     data.set_defaults(handler=run_data)
+
+    generate = actions.add_parser(
+        "generate", help="write kitchen files drawn from a seed (galley, L-shape, island, U layouts)",
+        description="Draw kitchens from the generator's distributions (a data file: layout families, fixtures, "
+                    "materials, lighting, noise, each kitchen's household of dishes) and write them as kitchen "
+                    "files, one per seed from --seed on. The same seed and distributions give the same bytes; "
+                    "every kitchen is checked like the shipped ones before it is written. Use a written file "
+                    "wherever a kitchen is asked for: --kitchen FOLDER/generated-N.toml.")
+    generate.add_argument("--seed", type=seed, required=True, help="seed of the first kitchen")
+    generate.add_argument("--count", type=positive_int, default=1, help="kitchens to write (default 1)")
+    generate.add_argument("--out", type=Path, required=True, help="folder to write the kitchen files into")
+    generate.add_argument("--distributions", type=Path, default=None, metavar="FILE",
+                          help="the generator's data file (default bullet_world/data/generator/kitchens.toml)")
+    generate.add_argument("--json", action="store_true", help="end with one JSON line of the written files")
+    generate.set_defaults(handler=run_generate)
 
 
 def run_show(args: argparse.Namespace) -> int:
@@ -200,4 +216,23 @@ def run_data(args: argparse.Namespace) -> int:
         print_json({"task": args.task, "kitchen": args.kitchen, "seed": args.seed, "train": sizes,
                           "test": len(datasets.test), "features": len(datasets.feature_names),
                           "file": meta.get("file"), "generator": meta.get("generator")})
+    return 0
+
+
+def run_generate(args: argparse.Namespace) -> int:
+    from bullet_world.generation import DEFAULT_DISTRIBUTIONS, generate_kitchens
+    from bullet_world.kitchen import load_kitchen
+
+    if args.out.exists() and not args.out.is_dir():
+        raise SettingsError(f"--out must be a folder, got the file '{args.out}'")
+    written = generate_kitchens(args.seed, args.count, args.out, args.distributions)
+    rows = []
+    for path in written:
+        kitchen = load_kitchen(path)
+        rows.append({"path": str(path), "name": kitchen.name, "seed": kitchen.generated["seed"],
+                     "family": kitchen.generated["family"]})
+        print(f"{path}: {kitchen.generated['family']}, {kitchen.counter_size[0]:.2f} x {kitchen.counter_size[1]:.2f} m "
+              f"worktop")
+    if args.json:
+        print_json({"kitchens": rows, "distributions": str(args.distributions or DEFAULT_DISTRIBUTIONS)})
     return 0

@@ -71,7 +71,7 @@ def test_a_small_run_covers_every_kind_and_finds_nothing_in_the_file_and_path_re
     assert sorted(small_run["per_kind"]) == sorted(
         ["study", "suite", "weights", "policy", "policy-npz", "kitchen", "task", "transcript", "replay",
          "study-transcript", "questionnaire", "study-note", "consent-record", "practice-transcript", "consent-text",
-         "demonstrations", "paths"])
+         "demonstrations", "generator", "generated-kitchen", "paths"])
     found = {kind: {name: counts[name] for name in COUNTS if counts[name]}
              for kind, counts in small_run["per_kind"].items() if kind not in OTHER_AREAS}
     assert not any(found.values()), (found, small_run["examples"])
