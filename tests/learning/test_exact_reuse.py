@@ -52,3 +52,53 @@ def test_a_quiet_turn_reuses_the_scored_what_ifs_and_gets_the_same_bits(rng):
     assert np.array_equal(reused.expected, fresh.expected)
     assert any(a == FeatureQuery() for a in fresh.actions)
     assert not np.array_equal(first.expected[-1], reused.expected[-1])  # the clock moved: not a stale table
+
+
+def _taught_state(rng):
+    state = LearningState(CONCEPTS, [f"f{i}" for i in range(5)], budget=20, turns=20)
+    scene, labels = _rows(rng, 12)
+    state.observe_scene(0, scene)
+    state.apply(LabelQuery(0), labels[0])
+    state.apply(LabelQuery(1), labels[1])
+    return state, scene, labels
+
+
+def test_a_quiet_decision_takes_its_learning_columns_from_the_cache_with_the_same_bits(rng):
+    state, _, _ = _taught_state(rng)
+    expected_decision_features(state, "fast")
+    state.apply(NoQuery())
+    kept = state.cache["candidates.learned"]
+    reused = expected_decision_features(state, "fast")
+    assert state.cache["candidates.learned"] is kept  # a hit: nothing recomputed
+    state.cache.clear()
+    fresh = expected_decision_features(state, "fast")
+    assert np.array_equal(reused.expected, fresh.expected) and np.array_equal(reused.current, fresh.current)
+    assert reused.actions == fresh.actions
+
+
+def test_a_new_model_version_or_scene_invalidates_the_decision_cache(rng):
+    state, scene, labels = _taught_state(rng)
+    expected_decision_features(state, "fast")
+    state.apply(LabelQuery(2), labels[2])  # a refit: a new version
+    after_answer = expected_decision_features(state, "fast")
+    state.observe_scene(1, scene[::-1].copy())  # a new scene (and scaler)
+    after_scene = expected_decision_features(state, "fast")
+    state.cache.clear()
+    assert np.array_equal(after_scene.expected, expected_decision_features(state, "fast").expected)
+    assert not np.array_equal(after_answer.expected[:, :4], after_scene.expected[:, :4])
+
+
+def test_the_candidates_are_kept_while_their_inputs_stay_and_built_anew_when_they_change(rng):
+    from learning.decision.candidates import candidate_actions
+
+    state, _, labels = _taught_state(rng)
+    first = candidate_actions(state)
+    assert candidate_actions(state) is first  # the same objects: the decision cache recognises them
+    state.apply(LabelQuery(3), labels[3])
+    again = candidate_actions(state)
+    assert LabelQuery(3) in first and LabelQuery(3) not in again
+    state.cache.clear()
+    assert candidate_actions(state) == again
+    state.place_progress(spent=18.5)  # only the label query is still affordable
+    cheap = candidate_actions(state)
+    assert cheap == tuple(a for a in again if a.kind in ("label", "none")) and len(cheap) < len(again)
