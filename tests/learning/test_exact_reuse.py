@@ -102,3 +102,43 @@ def test_the_candidates_are_kept_while_their_inputs_stay_and_built_anew_when_the
     state.place_progress(spent=18.5)  # only the label query is still affordable
     cheap = candidate_actions(state)
     assert cheap == tuple(a for a in again if a.kind in ("label", "none")) and len(cheap) < len(again)
+
+
+def test_computed_feature_subsets_are_kept_per_training_set_and_recomputed_when_it_changes(rng):
+    from learning.features.selection import computational_subsets
+
+    state = LearningState(CONCEPTS, [f"f{i}" for i in range(5)], budget=40, turns=40, feature_selection="ES")
+    scene, labels = _rows(rng, 20)
+    state.observe_scene(0, scene)
+    for i in range(8):
+        state.apply(LabelQuery(i), labels[i])
+    kept = state._selected
+    state.observe_scene(1, rng.normal(size=(20, 5)))  # a scene change refits with the same training set
+    assert state._selected is kept
+    X, taught = state.training_matrix()
+    fresh = computational_subsets(X, taught, CONCEPTS, method="ES")
+    for c in CONCEPTS:
+        assert np.array_equal(state.fitted_feature_subsets[c], fresh[c])
+    state.apply(LabelQuery(8), labels[8])  # a new training set: selected anew
+    assert state._selected is not kept
+    X, taught = state.training_matrix()
+    assert all(np.array_equal(state._selected[1][c], s)
+               for c, s in computational_subsets(X, taught, CONCEPTS, method="ES").items())
+
+
+def test_the_counts_are_kept_per_training_set_and_handed_out_as_a_new_dict(rng):
+    state, _, labels = _taught_state(rng)
+    counts = state.counts_per_concept()
+    counts["a"] += 100  # the caller's copy
+    assert state.counts_per_concept() == {c: int(sum(labels[:2] == c)) for c in CONCEPTS}
+    state.apply(LabelQuery(2), labels[2])
+    assert state.counts_per_concept() == {c: int(sum(labels[:3] == c)) for c in CONCEPTS}
+
+
+@pytest.mark.parametrize("indices", [np.array([3, 1, 3]), np.array([0], dtype=np.uint8), [2, 0], 4])
+def test_integer_subsets_take_the_short_check_with_the_same_result(indices):
+    from learning.concepts import checked_subset
+
+    assert np.array_equal(checked_subset(indices, 5), np.unique(np.asarray(indices).reshape(-1)))
+    with pytest.raises(ValueError, match="within 0..1"):
+        checked_subset(np.array([0, 2]), 2)
