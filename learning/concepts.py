@@ -130,15 +130,20 @@ class ConceptModels:
         self.subsets_ = {c: subsets.get(c) for c in self.concepts}
         models = {}
         kernels: dict[tuple, np.ndarray] = {}  # a fresh fit's kernel, shared by the concepts on the same columns
+        pending: dict[tuple, list[BinaryGPClassifier]] = {}  # fresh fits on one kernel: one batch of Newton steps
         try:
             for concept in self.concepts:
                 columns = self.columns(concept, X.shape[1])
                 key = tuple(columns.tolist())
                 model = BinaryGPClassifier(self.length_scale, self.variance).fit(
-                    X[:, columns], labels == concept, previous=fitted.get(concept), kernel=kernels.get(key))
+                    X[:, columns], labels == concept, previous=fitted.get(concept), kernel=kernels.get(key),
+                    defer_newton=True)
                 if len(X) and not model.incremental_:
                     kernels.setdefault(key, model.K_)
+                    pending.setdefault(key, []).append(model)
                 models[concept] = model
+            for group in pending.values():
+                BinaryGPClassifier.fit_together(group)
         except Exception:
             if previous is None:
                 del self.subsets_

@@ -142,3 +142,15 @@ def test_integer_subsets_take_the_short_check_with_the_same_result(indices):
     assert np.array_equal(checked_subset(indices, 5), np.unique(np.asarray(indices).reshape(-1)))
     with pytest.raises(ValueError, match="within 0..1"):
         checked_subset(np.array([0, 2]), 2)
+
+
+def test_batched_newton_steps_give_each_row_the_bits_of_its_own_fit(rng):
+    from learning.gp import newton_modes
+
+    X = rng.normal(size=(35, 4))
+    K = rbf_kernel(X, X, 2.0, 4.0)
+    targets = np.where(rng.random((5, 35)) < [[0.1], [0.5], [0.9], [0.3], [0.0]], 1.0, -1.0)  # rows converge apart
+    f, sw = newton_modes(K, targets, 30, 1e-6)
+    for row, t in enumerate(targets):
+        alone = BinaryGPClassifier().fit(X, t > 0, kernel=K)
+        assert np.array_equal(f[row], alone.f_hat_) and np.array_equal(sw[row], alone.W_sqrt_)
