@@ -58,6 +58,7 @@ class LearningState:
         self._training_arrays: tuple | None = None  # (examples, X, labels) of training_matrix
         self._selected: tuple | None = None  # (examples, subsets) of feature_selection: a scene change keeps them
         self._counts: tuple | None = None  # (examples, positives per concept) of counts_per_concept
+        self._rows_kept: tuple | None = None  # (read-only rows, scaler, scaled rows) of _scaled_rows
         self._seconds = None  # embodied costs: a learning.decision.embodied.SecondsClock (None: time in turns)
         self._refit()
 
@@ -336,8 +337,19 @@ class LearningState:
                 P.setflags(write=False)
                 self._scene_P = P
             return self._scene_P
-        return self._models.predict(self._scaler.transform(checked_rows(X, len(self.feature_names),
-                                                                         "rows to predict")))
+        return self._models.predict(self._scaled_rows(X))
+
+    def _scaled_rows(self, X) -> np.ndarray:
+        """``X`` checked and standardised. Read-only rows (a held-out set) are taken as unchanging: the last
+        such array is checked once and scaled once per scaler, not at every prediction (the same bits)."""
+        kept = self._rows_kept
+        if kept is not None and kept[0] is X and kept[1] is self._scaler:
+            return kept[2]
+        scaled = self._scaler.transform(checked_rows(X, len(self.feature_names), "rows to predict"))
+        if isinstance(X, np.ndarray) and not X.flags.writeable:
+            scaled.setflags(write=False)
+            self._rows_kept = (X, self._scaler, scaled)
+        return scaled
 
     def counts_per_concept(self) -> dict[str, int]:
         """Positive examples of each concept in the training set (counted once per training set; a new dict)."""

@@ -154,3 +154,19 @@ def test_batched_newton_steps_give_each_row_the_bits_of_its_own_fit(rng):
     for row, t in enumerate(targets):
         alone = BinaryGPClassifier().fit(X, t > 0, kernel=K)
         assert np.array_equal(f[row], alone.f_hat_) and np.array_equal(sw[row], alone.W_sqrt_)
+
+
+def test_read_only_held_out_rows_are_scaled_once_per_scaler_with_the_same_bits(rng):
+    state, _, _ = _taught_state(rng)
+    held_out = rng.normal(size=(50, 5))
+    held_out.setflags(write=False)
+    first = state.probabilities(held_out)
+    kept = state._rows_kept
+    assert np.array_equal(state.probabilities(held_out), first) and state._rows_kept is kept  # a hit
+    state.observe_scene(1, rng.normal(size=(12, 5)) * 3.0)  # a wider scaler pool: scaled anew
+    moved = state.probabilities(held_out)
+    assert state._rows_kept is not kept
+    assert np.array_equal(moved, state.probabilities(held_out.copy()))  # a writable copy: scaled, never kept
+    writable = held_out.copy()
+    state.probabilities(writable)
+    assert state._rows_kept[0] is held_out
