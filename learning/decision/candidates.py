@@ -139,17 +139,18 @@ def _expected_seven(state, engine, window_factor, actions, seconds, need_outcome
     counts = concept_counts(state)
     P = state.probabilities()
     durations = _expected_seconds(clock, actions, P, state.concepts)
-    key = (engine.name, state.version, state.scene_id, actions) \
+    version = (engine.name, state.version, state.scene_id, actions) \
         if getattr(engine, "outcomes_by_version", False) else None
-    entry = state.cache.get("candidates.learned") if key is not None else None
-    if entry is not None and entry[0] == key and not need_outcomes:
+    entry = state.cache.get("candidates.learned") if version is not None else None
+    if entry is not None and entry[0] == version and not need_outcomes:
         (now, learned), outcomes = entry[1], None
     else:
         now, learned, outcomes = _learned_columns(state, engine, actions, P, counts)
-        if key is not None:
-            if learned is not None:
-                learned.setflags(write=False)
-            state.cache["candidates.learned"] = (key, (now, learned))
+        if version is not None:
+            for kept in (now, learned):
+                if kept is not None:
+                    kept.setflags(write=False)
+            state.cache["candidates.learned"] = (version, (now, learned))
     environment = clock.features()
     current = np.concatenate([now, environment])
     quiet = np.concatenate([now, clock.after(state.cost(NoQuery()), asked=False,
