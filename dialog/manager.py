@@ -130,7 +130,10 @@ class DialogManager:
     def begin(self) -> None:
         """Draw the held-out test set and write the session header (once)."""
         if self._test is None:
-            self._test = self.env.test_set(self.test_scenes, self.rngs["test"])
+            test_X, test_y = self.env.test_set(self.test_scenes, self.rngs["test"])
+            test_X = np.array(test_X, dtype=float)  # our own read-only copy: the state scales it once per scaler
+            test_X.setflags(write=False)
+            self._test = (test_X, test_y)
         if not self.transcript.has_content:
             self.transcript.write_header(self.header())
 

@@ -130,15 +130,20 @@ class ConceptModels:
         self.subsets_ = {c: subsets.get(c) for c in self.concepts}
         models = {}
         kernels: dict[tuple, np.ndarray] = {}  # a fresh fit's kernel, shared by the concepts on the same columns
+        pending: dict[tuple, list[BinaryGPClassifier]] = {}  # fresh fits on one kernel: one batch of Newton steps
         try:
             for concept in self.concepts:
                 columns = self.columns(concept, X.shape[1])
                 key = tuple(columns.tolist())
                 model = BinaryGPClassifier(self.length_scale, self.variance).fit(
-                    X[:, columns], labels == concept, previous=fitted.get(concept), kernel=kernels.get(key))
+                    X[:, columns], labels == concept, previous=fitted.get(concept), kernel=kernels.get(key),
+                    defer_newton=True)
                 if len(X) and not model.incremental_:
                     kernels.setdefault(key, model.K_)
+                    pending.setdefault(key, []).append(model)
                 models[concept] = model
+            for group in pending.values():
+                BinaryGPClassifier.fit_together(group)
         except Exception:
             if previous is None:
                 del self.subsets_
@@ -174,13 +179,16 @@ class ConceptModels:
 
 def checked_subset(indices, n_features: int, what: str = "feature indices") -> np.ndarray:
     """Sorted unique whole-number column indices, non-empty and within ``0..n_features - 1``."""
-    values = np.asarray(indices if np.ndim(indices) else [indices], dtype=object).reshape(-1)
-    if len(values) == 0:
-        raise ValueError(f"{what} must name at least one feature (indices 0..{n_features - 1})")
-    wrong = [v for v in values if isinstance(v, (bool, np.bool_)) or not isinstance(v, (int, np.integer))]
-    if wrong:
-        raise ValueError(f"{what} must be whole-number feature indices 0..{n_features - 1}, got {wrong[0]!r}")
-    values = np.unique(values.astype(int))
+    if isinstance(indices, np.ndarray) and indices.dtype.kind in "iu" and indices.ndim == 1 and len(indices):
+        values = np.unique(indices.astype(int))  # whole numbers already: the element checks below would pass
+    else:
+        values = np.asarray(indices if np.ndim(indices) else [indices], dtype=object).reshape(-1)
+        if len(values) == 0:
+            raise ValueError(f"{what} must name at least one feature (indices 0..{n_features - 1})")
+        wrong = [v for v in values if isinstance(v, (bool, np.bool_)) or not isinstance(v, (int, np.integer))]
+        if wrong:
+            raise ValueError(f"{what} must be whole-number feature indices 0..{n_features - 1}, got {wrong[0]!r}")
+        values = np.unique(values.astype(int))
     outside = values[(values < 0) | (values >= n_features)]
     if len(outside):
         raise ValueError(f"{what} must be within 0..{n_features - 1}, got {outside[0]}")

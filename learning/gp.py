@@ -47,7 +47,7 @@ class BinaryGPClassifier:
         self.incremental_from = incremental_from
 
     def fit(self, X: np.ndarray, y: np.ndarray, previous: BinaryGPClassifier | None = None,
-            kernel: np.ndarray | None = None) -> BinaryGPClassifier:
+            kernel: np.ndarray | None = None, defer_newton: bool = False) -> BinaryGPClassifier:
         """Fit on rows ``X`` with labels ``y`` in {0, 1} (or booleans).
 
         ``previous``: an earlier fit of this kind. When ``X`` and ``y`` only append rows to its training set
@@ -55,6 +55,8 @@ class BinaryGPClassifier:
         is reused and Newton starts at its mode. The result equals a fresh fit within the Newton tolerance.
         ``kernel``: ``rbf_kernel(X, X)`` as another classifier on the same rows and kernel already computed it
         (the same bits); a fresh fit uses it instead of computing it again, is never written to it.
+        ``defer_newton``: a fresh fit stops before Newton (``pending_`` True); ``fit_together`` then finds
+        the modes of several such fits on one kernel at once.
         """
         X = np.asarray(X, dtype=float)
         y = np.asarray(y).astype(float).ravel()
@@ -63,7 +65,7 @@ class BinaryGPClassifier:
         self.X_train_ = X
         self.length_scale_ = self.length_scale or default_length_scale(X.shape[1])
         self.targets_ = 2.0 * y - 1.0  # {-1, +1}
-        self.incremental_ = False
+        self.incremental_ = self.pending_ = False
         if len(y) == 0:
             self.f_hat_ = np.zeros(0)
             return self
@@ -76,9 +78,24 @@ class BinaryGPClassifier:
             if kernel is not None and kernel.shape != (len(X), len(X)):
                 raise ValueError(f"kernel must be ({len(X)}, {len(X)}) for {len(X)} rows, got {kernel.shape}")
             self.K_ = rbf_kernel(X, X, self.length_scale_, self.variance) if kernel is None else kernel
+            if defer_newton:
+                self.pending_ = True
+                return self
             self.f_hat_, self.W_sqrt_, self.L_ = self._newton(self.K_, self.targets_)
         self.grad_ = (self.targets_ + 1) / 2 - sigmoid(self.f_hat_)  # d log p(y|f) / df at the mode
         return self
+
+    @staticmethod
+    def fit_together(models: list[BinaryGPClassifier]) -> None:
+        """Finish fresh fits left ``pending_`` on one shared kernel: their Newton steps as one batch
+        (``newton_modes``), each model's bits as its own ``_newton`` would give them."""
+        first = models[0]
+        f, sw = newton_modes(first.K_, np.stack([m.targets_ for m in models]), first.max_newton_steps,
+                             first.tolerance)
+        for model, f_hat, w_sqrt in zip(models, f, sw):
+            model.f_hat_, model.W_sqrt_, model.L_ = f_hat, w_sqrt, mode_factor(model.K_, w_sqrt)
+            model.grad_ = (model.targets_ + 1) / 2 - sigmoid(model.f_hat_)
+            model.pending_ = False
 
     def _extends(self, previous: BinaryGPClassifier) -> bool:
         """Whether this fit's training set is ``previous``'s with rows appended, under the same kernel."""
@@ -128,25 +145,9 @@ class BinaryGPClassifier:
 
     def _newton(self, K: np.ndarray, t: np.ndarray, start: np.ndarray | None = None):
         """Mode of p(f | X, y) by Newton's method (R&W algorithm 3.1), from f = 0 unless ``start`` is given."""
-        n = len(t)
-        f = np.zeros(n) if start is None else start
-        for _ in range(self.max_newton_steps):
-            pi = sigmoid(f)
-            W = pi * (1 - pi)
-            sw = np.sqrt(W)
-            B = np.eye(n) + sw[:, None] * K * sw[None, :]
-            L = dense_factor(B)
-            grad = (t + 1) / 2 - pi
-            b = W * f + grad
-            a = b - sw * dense_solve(L, sw * (K @ b))
-            f_new = K @ a
-            if np.max(np.abs(f_new - f)) < self.tolerance:
-                f = f_new
-                break
-            f = f_new
-        pi = sigmoid(f)
-        sw = np.sqrt(pi * (1 - pi))
-        return f, sw, mode_factor(K, sw)
+        f, sw = newton_modes(K, t[None], self.max_newton_steps, self.tolerance,
+                             None if start is None else start[None])
+        return f[0], sw[0], mode_factor(K, sw[0])
 
     def latent(self, X: np.ndarray, cross: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
         """Predictive mean and variance of the latent function (R&W algorithm 3.2); ``cross`` is
@@ -165,6 +166,47 @@ class BinaryGPClassifier:
         """p(y = 1 | x) by the probit approximation sigma(mu / sqrt(1 + pi var / 8)) (``cross``: see ``latent``)."""
         mean, var = self.latent(X, cross)
         return sigmoid(mean / np.sqrt(1.0 + np.pi * var / 8.0))
+
+
+def newton_modes(K: np.ndarray, targets: np.ndarray, max_steps: int, tolerance: float,
+                 start: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Modes f (g, n) and W^1/2 at them of p(f | X, y) for label rows ``targets`` (g, n) in {-1, +1} sharing
+    the kernel K, by Newton's method (R&W algorithm 3.1) from 0 or ``start``; a row stops once its latent
+    values move by less than ``tolerance``. The elementwise steps run on all rows at once; each row's
+    products with K and its Cholesky calls are its own, so every row gets the bits of a fit alone.
+    """
+    g, n = targets.shape
+    f = np.zeros((g, n)) if start is None else np.array(start, dtype=float)
+    positive = (targets + 1) / 2
+    active = np.arange(g)
+    for _ in range(max_steps):
+        f_now = f if len(active) == g else f[active]
+        pi = sigmoid(f_now)
+        W = pi * (1 - pi)
+        sw = np.sqrt(W)
+        B = np.multiply(sw[:, :, None], K)  # B = I + S K S, built in place: the bits of eye(n) + sw K sw
+        B *= sw[:, None, :]
+        B.reshape(len(active), n * n)[:, :: n + 1] += 1.0
+        grad = positive[active] - pi
+        b = W * f_now + grad
+        right = np.empty_like(b)
+        for row in range(len(active)):
+            right[row] = K @ b[row]
+        right *= sw
+        for row in range(len(active)):
+            right[row] = dense_solve(dense_factor(B[row]), right[row])
+        right *= sw
+        a = b - right
+        f_new = np.empty_like(a)
+        for row in range(len(active)):
+            f_new[row] = K @ a[row]
+        moved = np.max(np.abs(f_new - f_now), axis=1)
+        f[active] = f_new
+        active = active[moved >= tolerance]
+        if len(active) == 0:
+            break
+    pi = sigmoid(f)
+    return f, np.sqrt(pi * (1 - pi))
 
 
 # The chord steps of an incremental refit stop once the latent values move by less than this fraction of the

@@ -56,6 +56,9 @@ class LearningState:
         self.cache: dict = {}  # what-if engines memoise (version, value) entries here; not learning state
         self._scene_P: np.ndarray | None = None
         self._training_arrays: tuple | None = None  # (examples, X, labels) of training_matrix
+        self._selected: tuple | None = None  # (examples, subsets) of feature_selection: a scene change keeps them
+        self._counts: tuple | None = None  # (examples, positives per concept) of counts_per_concept
+        self._rows_kept: tuple | None = None  # (read-only rows, scaler, scaled rows) of _scaled_rows
         self._seconds = None  # embodied costs: a learning.decision.embodied.SecondsClock (None: time in turns)
         self._refit()
 
@@ -197,7 +200,10 @@ class LearningState:
         subsets = dict(self._subsets)
         if self.feature_selection is None or len(X) == 0 or all(s is not None for s in subsets.values()):
             return subsets
-        chosen = computational_subsets(X, labels, self.concepts, method=self.feature_selection)
+        if self._selected is None or self._selected[0] is not self._examples:  # once per training set
+            self._selected = (self._examples, computational_subsets(X, labels, self.concepts,
+                                                                    method=self.feature_selection))
+        chosen = self._selected[1]
         return {c: subsets[c] if subsets[c] is not None else chosen.get(c) for c in self.concepts}
 
     def check_action(self, action: Action) -> None:
@@ -331,15 +337,28 @@ class LearningState:
                 P.setflags(write=False)
                 self._scene_P = P
             return self._scene_P
-        return self._models.predict(self._scaler.transform(checked_rows(X, len(self.feature_names),
-                                                                         "rows to predict")))
+        return self._models.predict(self._scaled_rows(X))
+
+    def _scaled_rows(self, X) -> np.ndarray:
+        """``X`` checked and standardised. Read-only rows (a held-out set) are taken as unchanging: the last
+        such array is checked once and scaled once per scaler, not at every prediction (the same bits)."""
+        kept = self._rows_kept
+        if kept is not None and kept[0] is X and kept[1] is self._scaler:
+            return kept[2]
+        scaled = self._scaler.transform(checked_rows(X, len(self.feature_names), "rows to predict"))
+        if isinstance(X, np.ndarray) and not X.flags.writeable:
+            scaled.setflags(write=False)
+            self._rows_kept = (X, self._scaler, scaled)
+        return scaled
 
     def counts_per_concept(self) -> dict[str, int]:
-        """Positive examples of each concept in the training set."""
-        counts = {c: 0 for c in self.concepts}
-        for example in self._examples:
-            counts[example.concept] += 1
-        return counts
+        """Positive examples of each concept in the training set (counted once per training set; a new dict)."""
+        if self._counts is None or self._counts[0] is not self._examples:
+            counts = {c: 0 for c in self.concepts}
+            for example in self._examples:
+                counts[example.concept] += 1
+            self._counts = (self._examples, counts)
+        return dict(self._counts[1])
 
     def predict(self, X: np.ndarray) -> np.ndarray:
         """The most probable concept name for each row."""

@@ -7,6 +7,7 @@ does the work: load, run, report, check.
 from __future__ import annotations
 
 import argparse
+import os
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -21,7 +22,7 @@ from dialog.experiments.baseline import (
 )
 from dialog.experiments.kinds import RunOptions, get_kind, run_suite
 from dialog.experiments.progress import EventProgress, Progress, SweepProgress
-from dialog.experiments.runner import episode_specs
+from dialog.experiments.runner import EpisodePool, episode_specs
 from dialog.experiments.suite import load_suite, suite_names
 from dialog.output_paths import check_writable, writing
 from dialog.printed_command import command_line
@@ -186,6 +187,18 @@ def render_only(args: argparse.Namespace, kind, suite) -> int:
     return 0
 
 
+@contextmanager
+def shared_pool(args: argparse.Namespace) -> Iterator:
+    """One pool of worker processes for every data seed of the run (``EpisodePool``), or None where each run
+    has its own way (Ray, or one worker: episodes in this process)."""
+    workers = args.workers or os.cpu_count() or 1
+    if args.ray or workers < 2:
+        yield None
+        return
+    with EpisodePool(workers) as pool:
+        yield pool
+
+
 def run_on_data_seeds(args: argparse.Namespace, kind, suite, original, out: Path) -> int:
     """--data-seeds: one run per data seed, each with its report, then the findings pooled over all of them."""
     from dialog.experiments.data_seeds import (
@@ -206,17 +219,23 @@ def run_on_data_seeds(args: argparse.Namespace, kind, suite, original, out: Path
         raise SettingsError(f"--data-seeds renders the data sets of episodes suites; '{suite.name}' is a "
                             f"{kind.name} suite")
     runs = {}
-    with sweep_progress(args, kind, suite, out, len(seeds)) as sweep:
-        for seed in seeds:
+    with sweep_progress(args, kind, suite, out, len(seeds)) as sweep, shared_pool(args) as pool:
+        def options_for(seed: int) -> RunOptions:
+            return RunOptions(results=out / f"data-seed-{seed}", workers=args.workers, ray=args.ray,
+                              progress=shows_bars(args), sweep=sweep, pool=pool)
+
+        for index, seed in enumerate(seeds):
             folder = out / f"data-seed-{seed}"
             if sweep is not None:
                 sweep.describe(f"data seed {seed}")
             with writing(folder, "results", inside=True):
                 folder.mkdir(parents=True, exist_ok=True)
-                one = suite.with_overrides(data_seed=seed)
-                options = RunOptions(results=folder, workers=args.workers, ray=args.ray, progress=shows_bars(args),
-                                     sweep=sweep)
-                runs[seed] = run_suite(kind, one, options, original)
+                runs[seed] = run_suite(kind, suite.with_overrides(data_seed=seed), options_for(seed), original)
+            if pool is not None and index + 1 < len(seeds):  # the next data seed's episodes run meanwhile
+                following = seeds[index + 1]
+                with writing(out / f"data-seed-{following}", "results", inside=True):
+                    kind.start(suite.with_overrides(data_seed=following), options_for(following))
+            with writing(folder, "results", inside=True):
                 report = kind.report(runs[seed], folder)[0]
             done = (f"{suite.name} on data seed {seed}: {runs[seed].count} runs in {runs[seed].seconds:.1f} s; "
                     f"report {report}")

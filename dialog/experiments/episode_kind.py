@@ -38,16 +38,26 @@ class EpisodesKind(SuiteKind):
                                  f"the checkpoints {list(suite.checkpoints)}")
         return suite
 
-    def run(self, suite: Suite, options: RunOptions) -> SuiteRun:
-        started = time.perf_counter()
+    def start(self, suite: Suite, options: RunOptions) -> list:
+        """Render the suite's data sets (once, before the workers) and, with a shared ``options.pool``, start its
+        episodes there now; the specs of every episode."""
         what = f"{suite.task}/{suite.kitchen}" + (f" (data seed {suite.data_seed})" if suite.data_seed else "")
-        with RenderBar(what, options.progress) as bar:  # once, before the workers
+        with RenderBar(what, options.progress) as bar:
             load_pools(suite.task, suite.kitchen, suite.datasets, suite.plan_options, progress=bar,
                        data_seed=suite.data_seed)
         specs = episode_specs(suite, options.results)
+        if options.pool is not None:
+            options.pool.submit(specs)
+        return specs
+
+    def run(self, suite: Suite, options: RunOptions) -> SuiteRun:
+        started = time.perf_counter()
+        specs = self.start(suite, options)
         sweep_started = time.perf_counter()
         progress = options.progress if options.sweep is None else options.sweep
-        if options.ray:
+        if options.pool is not None:
+            results = options.pool.results(specs, progress)
+        elif options.ray:
             results = run_on_ray(specs, options.ray, progress)
         else:
             results = run_locally(specs, options.workers, progress)

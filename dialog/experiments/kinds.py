@@ -40,6 +40,7 @@ class RunOptions:
     ray: str | None = None
     progress: bool = True
     sweep: Progress | None = None
+    pool: Any = None  # a dialog.experiments.runner.EpisodePool shared by several runs (None: the run's own)
 
 
 @dataclass(frozen=True)

@@ -9,7 +9,7 @@ import tempfile
 import threading
 import time
 from collections.abc import Callable
-from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures import Future, ProcessPoolExecutor, as_completed
 from dataclasses import replace
 from pathlib import Path
 
@@ -61,6 +61,40 @@ def run_locally(specs: list[EpisodeSpec], workers: int | None = None,
                     results[index] = future.result()
                     advance(specs[index].label)
     return results
+
+
+class EpisodePool:
+    """One pool of worker processes for several runs of episodes (``regress --data-seeds``: every data seed of a
+    suite), so that workers start once and the next data seed's episodes run while the last one's report is
+    written. ``submit`` starts episodes early; ``results`` returns a run's results in the order of its specs,
+    as ``run_locally`` does (each episode is the same pure function of its spec, wherever it runs)."""
+
+    def __init__(self, workers: int):
+        self.workers = workers
+        self._executor = ProcessPoolExecutor(max_workers=workers)
+        self._futures: dict[str, Future] = {}  # by transcript path: one per episode of a run
+
+    def submit(self, specs: list[EpisodeSpec]) -> None:
+        for spec in specs:
+            if spec.transcript not in self._futures:
+                self._futures[spec.transcript] = self._executor.submit(run_episode, spec)
+
+    def results(self, specs: list[EpisodeSpec], progress: ProgressOption = True) -> list[dict]:
+        self.submit(specs)  # any not started yet
+        futures = {self._futures.pop(spec.transcript): i for i, spec in enumerate(specs)}
+        results: list[dict | None] = [None] * len(specs)
+        with _progress(len(specs), progress) as advance:
+            for future in as_completed(futures):
+                index = futures[future]
+                results[index] = future.result()
+                advance(specs[index].label)
+        return results
+
+    def __enter__(self) -> EpisodePool:
+        return self
+
+    def __exit__(self, kind, *exc) -> None:
+        self._executor.shutdown(wait=True, cancel_futures=kind is not None)
 
 
 def run_on_ray(specs: list[EpisodeSpec], address: str, progress: ProgressOption = True) -> list[dict]:

@@ -34,7 +34,6 @@ from learning.decision.embodied import absent_chance
 from learning.decision.features import (
     FEATURE_NAMES,
     concept_counts,
-    features,
     label_distribution,
     learning_features,
     state_clock,
@@ -68,7 +67,22 @@ class CandidateFeatures:
 
 
 def candidate_actions(state) -> tuple[Action, ...]:
-    """The affordable candidates of this turn in the fixed order (module docstring); NoQuery is always last."""
+    """The affordable candidates of this turn in the fixed order (module docstring); NoQuery is always last.
+
+    A state with a ``cache`` keeps the tuple while its inputs (the scene and what was said about it, the
+    feature question, what the budget affords per kind) stay the same: the same objects, so that the
+    decision cache of ``_expected_seven`` recognises them by identity."""
+    kinds = {"demo": DemoQuery(state.concepts[0]), "label": LabelQuery(0), "feature": FeatureQuery()}
+    affordable = {kind: state.can_afford(action) for kind, action in kinds.items()}  # a cost is its kind's
+    cache = getattr(state, "cache", None)
+    if cache is None:
+        return _candidate_actions(state, affordable)
+    key = (state.scene_id, len(state.scene_X), state.labelled_in_scene, state.absent_in_scene,
+           state.feature_query_asked, tuple(affordable.values()))
+    return cached(state, "candidates.actions", key, lambda: _candidate_actions(state, affordable))
+
+
+def _candidate_actions(state, affordable: dict[str, bool]) -> tuple[Action, ...]:
     n_objects = len(state.scene_X)
     labelled = state.labelled_in_scene
     # A demonstration is drawn from the scene: none without objects, nor for a concept the teacher
@@ -77,10 +91,6 @@ def candidate_actions(state) -> tuple[Action, ...]:
     queries += [LabelQuery(i) for i in range(n_objects) if i not in labelled]
     if not state.feature_query_asked:
         queries.append(FeatureQuery())
-    affordable: dict[str, bool] = {}  # a query's cost is its kind's: ask the budget once per kind
-    for action in queries:
-        if action.kind not in affordable:
-            affordable[action.kind] = state.can_afford(action)
     return tuple(a for a in queries if affordable[a.kind]) + (NoQuery(),)
 
 
@@ -95,7 +105,7 @@ def expected_decision_features(state, engine: str | WhatIfEngine = "fast", windo
     ``seconds`` of the result holds E[seconds(a)]. ``habits`` appends the expert-habit features of
     ``learning.decision.habits`` (columns EXTENDED_FEATURE_NAMES; ``current`` keeps the seven).
     """
-    table = _expected_seven(state, engine, window_factor, actions, seconds)
+    table = _expected_seven(state, engine, window_factor, actions, seconds, need_outcomes=habits)
     if not habits:
         return table.candidates
     P, counts = table.probabilities, table.counts
@@ -115,29 +125,67 @@ class _SevenFeatureTable:
     outcomes: object  # learning.whatif.Outcomes, or None when no query needed simulating
 
 
-def _expected_seven(state, engine, window_factor, actions, seconds) -> _SevenFeatureTable:
-    """The candidates with E[phi(s') | a] over the thesis's seven features (eq. 6.3, 7.1)."""
+def _expected_seven(state, engine, window_factor, actions, seconds, need_outcomes=False) -> _SevenFeatureTable:
+    """The candidates with E[phi(s') | a] over the thesis's seven features (eq. 6.3, 7.1).
+
+    The learning-feature columns of every row, and phi(s)'s own, are a function of the model version, the
+    scene and the candidates when the engine's outcomes are (``outcomes_by_version``, the fast engine's): a
+    turn with none of them changed (a quiet one) takes them from the state's cache, the same bits; only the
+    environment columns are computed anew. ``need_outcomes``: simulate anyway (the table carries them).
+    """
     engine = make_engine(engine)
     actions = candidate_actions(state) if actions is None else tuple(actions)
     clock = state_clock(state, window_factor, seconds)
     counts = concept_counts(state)
     P = state.probabilities()
-    current = features(P, counts, clock)
-    n_learning = len(current) - len(clock.features())
     durations = _expected_seconds(clock, actions, P, state.concepts)
-    quiet = np.concatenate([current[:n_learning],
-                            clock.after(state.cost(NoQuery()), asked=False, seconds=_quiet_seconds(clock)).features()])
+    version = (engine.name, state.version, state.scene_id, actions) \
+        if getattr(engine, "outcomes_by_version", False) else None
+    entry = state.cache.get("candidates.learned") if version is not None else None
+    if entry is not None and entry[0] == version and not need_outcomes:
+        (now, learned), outcomes = entry[1], None
+    else:
+        now, learned, outcomes = _learned_columns(state, engine, actions, P, counts)
+        if version is not None:
+            for kept in (now, learned):
+                if kept is not None:
+                    kept.setflags(write=False)
+            state.cache["candidates.learned"] = (version, (now, learned))
+    environment = clock.features()
+    current = np.concatenate([now, environment])
+    quiet = np.concatenate([now, clock.after(state.cost(NoQuery()), asked=False,
+                                             seconds=_quiet_seconds(clock)).features()])
+    if learned is None:  # no query to simulate: every row is no query's next state
+        return _SevenFeatureTable(CandidateFeatures(actions, np.tile(quiet, (len(actions), 1)), current,
+                                                    seconds=durations), P, counts, None)
+    expected = np.empty((len(actions), len(current)))
+    expected[:, : len(now)] = learned
+    after = {}  # the next turn's environment features, per query cost
+    for i, action in enumerate(actions):
+        if action.kind == "none":
+            expected[i] = quiet
+            continue
+        key = (state.cost(action), 0.0 if durations is None else float(durations[i]))
+        if key not in after:
+            after[key] = clock.after(key[0], asked=True, seconds=key[1]).features()
+        expected[i, len(now) :] = after[key]
+    return _SevenFeatureTable(CandidateFeatures(actions, expected, current, seconds=durations), P, counts, outcomes)
+
+
+def _learned_columns(state, engine, actions, P, counts):
+    """phi(s)'s learning features, E[learning features of s' | a] per row (no query's rows left unset; None
+    when there is no query to simulate) and the engine's outcomes (eq. 6.3)."""
+    now = learning_features(P, counts)
     label_objects = [a.object_index for a in actions if a.kind == "label"]
     wants_feature_query = any(a.kind == "feature" for a in actions)
     if not (label_objects or wants_feature_query or any(a.kind == "demo" for a in actions)):
-        return _SevenFeatureTable(CandidateFeatures(actions, np.tile(quiet, (len(actions), 1)), current,
-                                                    seconds=durations), P, counts, None)
+        return now, None, None
     outcomes = engine.simulate(state, label_objects, wants_feature_query)
     n_concepts = len(state.concepts)
     with_one_more = counts + np.eye(n_concepts)  # row y: the counts after one more example of concept y
     # Learning features of every simulated next state, all at once: (|Y|, |X|, 4), (k, |Y|, 4), (|Y|, 4).
     # Shared outcomes (the fast engine's) are a function of the model version and the scene, and so are the
-    # counts: a turn with neither changed (a quiet one) reuses the features scored last turn, the same bits.
+    # counts: a turn with neither changed reuses the features scored before, the same bits.
     reuse = (state.version, state.scene_id) if outcomes.shared else None
     demo_phi = _scored(state, "demo", reuse, lambda: learning_features(outcomes.demo, with_one_more[:, None, :]))
     if outcomes.shared:  # the same <x, y> states: score them once
@@ -148,8 +196,7 @@ def _expected_seven(state, engine, window_factor, actions, seconds) -> _SevenFea
         state, "feature", reuse, lambda: learning_features(outcomes.feature, counts))
     label_rows = {index: k for k, index in enumerate(outcomes.label_objects)}
     concept_index = {c: k for k, c in enumerate(state.concepts)}
-    expected = np.empty((len(actions), len(current)))
-    learned = expected[:, : demo_phi.shape[-1]]
+    learned = np.empty((len(actions), demo_phi.shape[-1]))
     positions = {kind: [i for i, a in enumerate(actions) if a.kind == kind] for kind in ("demo", "label", "feature")}
     if positions["demo"]:  # the teacher's object x with p(x|y), the classifier's column normalised over the scene
         ys = [concept_index[a.concept] for a in actions if isinstance(a, DemoQuery)]
@@ -162,16 +209,7 @@ def _expected_seven(state, engine, window_factor, actions, seconds) -> _SevenFea
     if positions["feature"]:  # each F_{y,c} with probability 1/|Y|
         assert feature_phi is not None, "the engine simulates the feature query whenever one is a candidate"
         learned[positions["feature"]] = feature_phi.mean(axis=0)
-    after = {}  # the next turn's environment features, per query cost
-    for i, action in enumerate(actions):
-        if action.kind == "none":
-            expected[i] = quiet
-            continue
-        key = (state.cost(action), 0.0 if durations is None else float(durations[i]))
-        if key not in after:
-            after[key] = clock.after(key[0], asked=True, seconds=key[1]).features()
-        expected[i, learned.shape[1] :] = after[key]
-    return _SevenFeatureTable(CandidateFeatures(actions, expected, current, seconds=durations), P, counts, outcomes)
+    return now, learned, outcomes
 
 
 def _scored(state, part: str, version, compute):

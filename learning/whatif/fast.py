@@ -60,6 +60,7 @@ THREE_FEATURES_FROM = 300  # three features need ~100 columns: cheaper than dens
 
 class FastEngine(WhatIfEngine):
     name = "fast"
+    outcomes_by_version = True  # its outcomes are a function of the model version and the scene (cached so)
 
     def simulate(self, state, label_objects: Sequence[int], feature_query: bool) -> Outcomes:
         pairs = cached(state, "fast.pairs", (state.version, state.scene_id), lambda: pair_table(state))

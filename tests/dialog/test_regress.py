@@ -278,3 +278,28 @@ def test_render_only_prepares_every_data_seed_and_plays_nothing(tmp_path, capsys
     assert "data seed 3) are ready" in lines[0] and json.loads(lines[-1])["data_seeds"] == [3, 4]
     assert main(["regress", "--suite", str(suite), "--render-only", "--check"]) == 2
     assert "--render-only plays no episode" in capsys.readouterr().err
+
+
+def test_data_seeds_share_one_pool_and_give_the_files_of_a_run_in_one_process(tmp_path, capsys, monkeypatch):
+    """Issue 54 item 3: one pool serves every data seed (the next one's episodes start before the last report
+    is written); every transcript and the pooled numbers are those of the same run played in this process."""
+    from dialog.experiments import runner
+
+    pools = []
+    monkeypatch.setattr(runner.EpisodePool, "__enter__", lambda self: pools.append(self) or self)
+    suite = write_suite(tmp_path)
+    outs = {workers: tmp_path / f"out-{workers}" for workers in ("1", "2")}
+    for workers, out in outs.items():
+        assert main(["regress", "--suite", str(suite), "--data-seeds", "0", "1", "2", "--results", str(out),
+                     "--workers", workers, "--no-progress", "--json"]) == 0
+    assert len(pools) == 1 and pools[0].workers == 2 and not pools[0]._futures  # one pool, every episode collected
+    alone, shared = (sorted(p.relative_to(out) for p in out.rglob("*.jsonl")) for out in outs.values())
+    assert alone == shared and len(alone) == 12
+    for path in alone:
+        assert (outs["1"] / path).read_bytes() == (outs["2"] / path).read_bytes()
+
+    def numbers(out):
+        summary = json.loads((out / "replication.json").read_text())
+        return {key: value for key, value in summary.items() if key not in ("seconds", "command")}
+
+    assert numbers(outs["1"]) == numbers(outs["2"])
