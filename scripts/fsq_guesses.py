@@ -8,7 +8,8 @@ where one label or demonstration question is at least as good as the real answer
 groups the real answer's one-step change by the examples the learner holds.
 Applies the file's rule and prints its verdict; --json ends with one JSON line.
 
-    .venv/bin/python scripts/fsq_guesses.py --data choice|confirmation [--horizon] [--json] [--datasets N] [--seeds N ...]
+    .venv/bin/python scripts/fsq_guesses.py --data choice|confirmation [--horizon] [--json]
+                                            [--datasets N] [--seeds N ...]
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
+from dialog.experiments.doc_tables import markdown_table  # noqa: E402
 from dialog.experiments.fsq_guesses import by_examples, dominated, guess_table, horizon_table  # noqa: E402
 from dialog.experiments.provenance import git_commit  # noqa: E402
 from dialog.experiments.whatif_calibration import calibration_specs, run_calibration  # noqa: E402
@@ -31,6 +33,15 @@ from learning.whatif.feature_guesses import GUESSES  # noqa: E402
 DEFAULTS = ROOT / "dialog" / "data" / "calibration" / "fsq-guesses.toml"
 SHORT = {"classifier_discriminability": "ACD", "instance_variation": "IV", "prediction_margin": "PM",
          "accuracy": "accuracy"}
+
+
+COMPARED = ["n", "mean predicted", "mean realised", "r", "mean abs. error"]
+
+
+def compared(row: dict) -> list[str]:
+    """A table row's cells under COMPARED."""
+    r = "–" if row["correlation"] is None else f"{row['correlation']:.2f}"
+    return [str(row["n"]), f"{row['predicted']:+.4f}", f"{row['realised']:+.4f}", r, f"{row['mae']:.4f}"]
 
 
 def settings() -> dict:
@@ -89,35 +100,29 @@ def main(argv=None) -> int:
     print(f"{len(records)} states with the FSQ open in {len(specs)} episodes ({', '.join(config['strategies'])}), "
           f"data seed {run['data_seed']}, {datasets} data sets x seeds {seeds}, "
           f"{time.perf_counter() - started:.0f} s")
-    print("| guess | target | n | mean predicted | mean realised | r | mean abs. error |")
-    print("|---|---|---:|---:|---:|---:|---:|")
-    for row in rows:
-        r = "–" if row["correlation"] is None else f"{row['correlation']:.2f}"
-        print(f"| {row['guess']} | {SHORT[row['target']]} | {row['n']} | {row['predicted']:+.4f} | "
-              f"{row['realised']:+.4f} | {r} | {row['mae']:.4f} |")
+    print("\n".join(markdown_table(["guess", "target", *COMPARED], [[row["guess"], SHORT[row["target"]], *compared(row)]
+                                                                   for row in rows], right_from=2)))
     print(f"turns 1-5: the real answer is dominated by one instance question in "
           f"{counts['real_answer_dominated_early']} of {counts['early_states']} states "
           f"(later turns: {counts['real_answer_dominated_later']} of {len(records) - len(early)})")
     groups = by_examples(records)
-    print("| examples | states | real answer: ACD | real answer: held-out accuracy | best instance question: ACD |")
-    print("|---|---:|---:|---:|---:|")
-    for g in groups:
-        best = "–" if g["best_instance_acd"] is None else f"{g['best_instance_acd']:+.4f}"
-        print(f"| {g['examples']} | {g['states']} | {g['real_acd']:+.4f} | {g['real_accuracy']:+.4f} | {best} |")
+    print("\n".join(markdown_table(
+        ["examples", "states", "real answer: ACD", "real answer: held-out accuracy", "best instance question: ACD"],
+        [[g["examples"], str(g["states"]), f"{g['real_acd']:+.4f}", f"{g['real_accuracy']:+.4f}",
+          "–" if g["best_instance_acd"] is None else f"{g['best_instance_acd']:+.4f}"] for g in groups])))
     horizon = horizon_table(records, config["guesses"]) if args.horizon else []
     if horizon:
         print("against the real answer's change by the end of the episode:")
-        print("| guess | reading | target | turns | n | mean predicted | mean realised | r | mean abs. error |")
-        print("|---|---|---|---|---:|---:|---:|---:|---:|")
-        for row in horizon:
-            r = "–" if row["correlation"] is None else f"{row['correlation']:.2f}"
-            print(f"| {row['guess']} | {row['reading']} | {SHORT[row['target']]} | {row['turns']} | {row['n']} | "
-                  f"{row['predicted']:+.4f} | {row['realised']:+.4f} | {r} | {row['mae']:.4f} |")
+        print("\n".join(markdown_table(
+            ["guess", "reading", "target", "turns", *COMPARED],
+            [[row["guess"], row["reading"], SHORT[row["target"]], row["turns"], *compared(row)] for row in horizon],
+            right_from=4)))
     print("rule (lower MAE than", config["baseline"], "on", ", ".join(SHORT[t] for t in config["targets"]) + "):",
           ", ".join(better) or "no guess passes")
     if args.json:
         print(json.dumps({"data": args.data, "data_seed": run["data_seed"], "datasets": datasets, "seeds": seeds,
-                          "commit": git_commit(), "rows": rows, "counts": counts, "by_examples": groups, "horizon": horizon, "better": better,
+                          "commit": git_commit(), "rows": rows, "counts": counts, "by_examples": groups,
+                          "horizon": horizon, "better": better,
                           "per_strategy_states": {s: sum(r["strategy"] == s for r in records)
                                                   for s in config["strategies"]}}))
     return 0

@@ -24,6 +24,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
+from dialog.experiments.doc_tables import markdown_table  # noqa: E402
 from dialog.experiments.provenance import git_commit  # noqa: E402
 from dialog.experiments.runner import episode_specs, run_locally  # noqa: E402
 from dialog.experiments.suite import STATE_SCHEDULES, load_suite  # noqa: E402
@@ -46,7 +47,8 @@ def read_settings(path: Path = SETTINGS) -> dict:
         variants.append({"suite": text(table, "suite", here), "conditions": texts(table, "conditions", here),
                          "strategies": texts(table, "strategies", here, nonempty=True), "setting": setting,
                          "values": [int(v) if setting == "change_every" else v for v in values]})
-    return {"data_seed": integer(data, "data_seed", where, low=100), "datasets": integer(data, "datasets", where, low=1),
+    return {"data_seed": integer(data, "data_seed", where, low=100),
+            "datasets": integer(data, "datasets", where, low=1),
             "seeds": [int(s) for s in numbers(data, "seeds", where, whole=True, low=0)],
             "workers": integer(data, "workers", where, low=1), "variants": variants}
 
@@ -117,12 +119,12 @@ def main(argv=None) -> int:
                                "rows": summary, "dt_gap": dt_gap(summary)})
                 print(f"\n{variant['suite']}, {variant['setting']} = {value} (data seed {config['data_seed']}, "
                       f"{config['datasets']} data sets x seeds {config['seeds']}):")
-                print("| condition | strategy | final accuracy | questions | turns | at the bound |")
-                print("|---|---|---:|---:|---:|---:|")
-                for r in summary:
-                    se = "" if r["se"] is None else f" ± {r['se']:.3f}"
-                    print(f"| {r['condition']} | {r['strategy']} | {r['accuracy']:.3f}{se} | {r['questions']:.1f} | "
-                          f"{r['turns']:.1f} | {r['at_bound']} of {r['episodes']} |")
+                print("\n".join(markdown_table(
+                    ["condition", "strategy", "final accuracy", "questions", "turns", "at the bound"],
+                    [[r["condition"], r["strategy"],
+                      f"{r['accuracy']:.3f}" + ("" if r["se"] is None else f" ± {r['se']:.3f}"),
+                      f"{r['questions']:.1f}", f"{r['turns']:.1f}", f"{r['at_bound']} of {r['episodes']}"]
+                     for r in summary], right_from=2)))
                 for condition, gap in report[-1]["dt_gap"].items():
                     print(f"best DT minus best other, {condition}: {gap:+.3f}")
     seconds = time.perf_counter() - started

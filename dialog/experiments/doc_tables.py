@@ -95,6 +95,13 @@ def stamp(manifest: dict, command: str) -> str:
             f"`{command}`.</sub>")
 
 
+def markdown_table(header: list[str], rows: list[list[str]], right_from: int = 1) -> list[str]:
+    """A Markdown table's lines: ``header``, then ``rows`` (cells already formatted as text); the columns from
+    ``right_from`` on are aligned right (numbers)."""
+    rule = ["---" if i < right_from else "---:" for i in range(len(header))]
+    return [f"| {' | '.join(cells)} |" for cells in (header, rule, *rows)]
+
+
 def blocks_in(text: str) -> list[str]:
     """The names of the generated blocks in ``text``, in order; refuses an unclosed or doubled block."""
     names = [m.group("name") for m in BEGIN.finditer(text)]

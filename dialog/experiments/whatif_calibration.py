@@ -178,7 +178,8 @@ def calibration_specs(strategies, data_seed: int, datasets: int, seeds, turns: i
 def run_calibration(specs: list[EpisodeSpec], workers: int = 2, accuracy_what_if: bool = True,
                     feature_guesses: bool = False, horizon: bool = False) -> list[dict]:
     """Play every spec with the recorder (and the FSQ-guess probe), on ``workers`` processes; results in spec order."""
-    tasks = [CalibrationTask(spec, accuracy_what_if, feature_guesses=feature_guesses, horizon=horizon) for spec in specs]
+    tasks = [CalibrationTask(spec, accuracy_what_if, feature_guesses=feature_guesses, horizon=horizon)
+             for spec in specs]
     if workers == 1 or len(tasks) == 1:
         return [play(task) for task in tasks]
     with ProcessPoolExecutor(workers) as pool:
