@@ -131,6 +131,7 @@ def summarise(condition: str, rows: list[dict], checks: list[dict]) -> dict:
     reference_check = np.median([c["reference_cpu_ms"] for c in checks]) if checks else None
     return {
         "condition": condition, "decisions": len(rows), "scene_objects": sorted({row["scene"] for row in rows}),
+        "choices": int(sum(row["candidates"] > 1 for row in rows)),  # decisions with a question to choose
         "n_train": {"min": int(min(n_train)), "p50": int(np.median(n_train)), "max": int(max(n_train))},
         "fsq_open_share": round(float(fsq.mean()), 3),
         "cpu_ms": percentiles(cpu), "cpu_ms_cold": percentiles(cpu[cold]),

@@ -39,9 +39,13 @@ def test_the_json_line_summarises_every_condition(capsys):
     assert bench.main(bench._parse(["--suite", "smoke", "--datasets", "1", "--reference-every", "5", "--json"])) == 0
     report = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
     (row,) = report["conditions"]
-    assert row["condition"] == "static" and row["decisions"] == 20 and row["reference_checks"] == 4
+    assert row["condition"] == "static" and row["decisions"] == 20
+    assert 0 < row["choices"] <= 20 and row["reference_checks"] == row["choices"] // 5  # every fifth real choice
     assert row["cpu_ms"]["p50"] > 0 and row["cpu_ms"]["p95"] >= row["cpu_ms"]["p50"]
-    assert 0 < row["fsq_open_share"] < 1 and row["same_action"] >= 0.5 and row["speedup_cpu"] > 1
+    assert 0 < row["fsq_open_share"] < 1 and row["speedup_cpu"] > 1
+    # where the fast choice differs from the reference's, it is a near tie: expected utilities agree to < 1e-3
+    # (docs/strategies.md, the what-if engines' approximation error)
+    assert row["same_action"] > 0 and row["max_regret"] < 1e-3
 
 
 def test_a_condition_the_suite_lacks_gets_one_message_naming_the_accepted_ones():
