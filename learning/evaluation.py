@@ -13,3 +13,9 @@ def accuracy(predicted, truth) -> float:
     if len(truth) == 0:
         raise ValueError("accuracy needs at least one test instance")
     return float(np.mean(predicted == truth))
+
+
+def most_probable_accuracy(P, concepts, truth) -> float:
+    """Accuracy of the most probable concept of every row of p(y|x) (``P``: rows x concepts, as
+    ``LearningState.predict`` decides)."""
+    return accuracy(np.array(concepts, dtype=object)[np.argmax(np.asarray(P), axis=-1)], truth)

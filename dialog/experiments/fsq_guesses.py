@@ -26,14 +26,10 @@ import numpy as np
 
 from learning.decision.candidates import expected_decision_features
 from learning.decision.features import LEARNING_FEATURES, concept_counts, learning_features
-from learning.evaluation import accuracy
+from learning.evaluation import most_probable_accuracy
 from learning.whatif.feature_guesses import GUESSES, guessed_answers, refit_probabilities
 
 K = len(LEARNING_FEATURES)
-
-
-def _accuracy(P: np.ndarray, concepts, truth) -> float:
-    return accuracy(np.array(concepts, dtype=object)[np.argmax(P, axis=-1)], truth)
 
 
 def answer_effect(state, answers, test_X, test_y, training=None, scene=None, scaler=None) -> tuple[np.ndarray, float]:
@@ -49,7 +45,7 @@ def answer_effect(state, answers, test_X, test_y, training=None, scene=None, sca
     for probability, subsets in answers:
         P = refit_probabilities(state, subsets, rows, (X, labels), scaler)
         phi += probability * learning_features(P[:n], counts)[:K]
-        acc += probability * _accuracy(P[n:], state.concepts, test_y)
+        acc += probability * most_probable_accuracy(P[n:], state.concepts, test_y)
     return phi, acc
 
 
@@ -79,10 +75,8 @@ class FeatureGuessProbe:
             return
         test_X, test_y = self.manager._test  # the held-out pool the manager scores (drawn once, read here)
         phi = learning_features(state.probabilities(), concept_counts(state))[:K]
-        acc = _accuracy(state.probabilities(test_X), state.concepts, test_y)
-        names = list(state.feature_names)
-        teacher = np.array(sorted(names.index(name) for name in self.relevant))
-        real_phi, real_acc = answer_effect(state, [(1.0, {c: teacher for c in state.concepts})], test_X, test_y)
+        acc = most_probable_accuracy(state.probabilities(test_X), state.concepts, test_y)
+        real_phi, real_acc = answer_effect(state, self._teacher_answer(state), test_X, test_y)
         record = {"turn": self.manager.turn + 1, "examples": len(state.training_matrix()[0]),
                   "action": decision.action.kind, "phi": phi.tolist(), "accuracy": acc,
                   "realised": (real_phi - phi).tolist(), "realised_accuracy": real_acc - acc, "guesses": {}}
@@ -98,6 +92,12 @@ class FeatureGuessProbe:
 
     def on_turn(self, record: dict, scene) -> None:
         pass
+
+    def _teacher_answer(self, state) -> list[tuple]:
+        """The teacher's real answer as the one certain answer: every classifier on the task's relevant features."""
+        names = list(state.feature_names)
+        relevant = np.array(sorted(names.index(name) for name in self.relevant))
+        return [(1.0, {c: relevant for c in state.concepts})]
 
     def _horizon(self, state, record, test_X, test_y) -> None:
         X, labels = state.training_matrix()
@@ -115,12 +115,10 @@ class FeatureGuessProbe:
     def finish(self, state) -> list[dict]:
         """With ``horizon``: the real answer's change on the final training set, read on each record's scene."""
         test_X, test_y = self.manager._test
-        final = state.training_matrix()
-        teacher = np.array(sorted(list(state.feature_names).index(name) for name in self.relevant))
+        final, teacher = state.training_matrix(), self._teacher_answer(state)
         for record, scene, scaler, current in self._views:
             phi0, acc0 = answer_effect(state, [(1.0, current)], test_X, test_y, final, scene, scaler)
-            phi1, acc1 = answer_effect(state, [(1.0, {c: teacher for c in state.concepts})], test_X, test_y,
-                                       final, scene, scaler)
+            phi1, acc1 = answer_effect(state, teacher, test_X, test_y, final, scene, scaler)
             record["realised_by_end"], record["realised_accuracy_by_end"] = (phi1 - phi0).tolist(), acc1 - acc0
         return self.records
 

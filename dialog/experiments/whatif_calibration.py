@@ -35,15 +35,10 @@ from dialog.threads import one_blas_thread
 from dialog.transcripts.jsonl import TranscriptWriter
 from learning.actions import DemoQuery, LabelQuery
 from learning.decision.features import LEARNING_FEATURES, concept_counts, label_distribution, learning_features
-from learning.evaluation import accuracy
+from learning.evaluation import most_probable_accuracy
 from learning.whatif.fast import feature_outcomes, pair_table
 
 KINDS = ("label", "demo", "feature")
-
-
-def _accuracy(P: np.ndarray, concepts, truth: np.ndarray) -> float:
-    """Held-out accuracy of the most probable concept of every row (as ``LearningState.predict``)."""
-    return accuracy(np.array(concepts, dtype=object)[np.argmax(P, axis=-1)], truth)
 
 
 def predicted_accuracy(state, action, test_X: np.ndarray, test_y: np.ndarray) -> float:
@@ -53,15 +48,15 @@ def predicted_accuracy(state, action, test_X: np.ndarray, test_y: np.ndarray) ->
     if isinstance(action, LabelQuery):  # the teacher names concept y with p(y|x) normalised over the concepts
         table = pair_table(state, test_X)[action.object_index]  # [y, i, c]
         weights = label_distribution(P)[action.object_index]
-        return float(sum(w * _accuracy(table[y, n:], concepts, test_y) for y, w in enumerate(weights)))
+        return float(sum(w * most_probable_accuracy(table[y, n:], concepts, test_y) for y, w in enumerate(weights)))
     if isinstance(action, DemoQuery):  # the teacher shows object x with p(x|y) normalised over the scene
         y = concepts.index(action.concept)
         column = P[:, y]
         weights = column / column.sum() if column.sum() > 0 else np.full(n, 1.0 / n)
         table = pair_table(state, test_X)[:n, y]  # [x, i, c]
-        return float(sum(w * _accuracy(table[x, n:], concepts, test_y) for x, w in enumerate(weights)))
+        return float(sum(w * most_probable_accuracy(table[x, n:], concepts, test_y) for x, w in enumerate(weights)))
     outcome = feature_outcomes(state, test_X)  # the FSQ: each answer F_{y,c} with probability 1/|Y|
-    return float(np.mean([_accuracy(outcome[y, n:], concepts, test_y) for y in range(len(concepts))]))
+    return float(np.mean([most_probable_accuracy(outcome[y, n:], concepts, test_y) for y in range(len(concepts))]))
 
 
 class WhatIfRecorder:
