@@ -182,3 +182,35 @@ def accuracy_after_questions(questions: np.ndarray, accuracy: np.ndarray, checkp
         reached = np.nonzero(questions >= q)[0]
         values.append(accuracy[reached[0]] if len(reached) else np.nan)
     return np.array(values)
+
+
+def ranks_high_first(scores) -> np.ndarray:
+    """Rank 1 for the highest score; tied scores share their mean rank."""
+    return rankdata(-np.asarray(scores, dtype=float), method="average")
+
+
+def kendalls_w(ranks, rng: np.random.Generator, resamples: int = 2000) -> dict:
+    """Kendall's coefficient of concordance of ``ranks`` (raters x items, ties as mean ranks) with the tie
+    correction, W = 12 S / (m^2 (n^3 - n) - m sum T), T = sum (t^3 - t) over a rater's tie groups; Friedman's
+    chi-squared m (n - 1) W against n - 1 degrees of freedom; a percentile interval from resampling raters."""
+    from scipy.stats import chi2
+
+    ranks = np.asarray(ranks, dtype=float)
+    raters, items = ranks.shape
+    if raters < 2 or items < 2:
+        raise ValueError(f"Kendall's W needs at least 2 raters and 2 items, got {raters} x {items}")
+
+    def w_of(table: np.ndarray) -> float:
+        m = len(table)
+        totals = table.sum(axis=0)
+        spread = float(((totals - totals.mean()) ** 2).sum())
+        ties = sum(float((counts ** 3 - counts).sum())
+                   for counts in (np.unique(row, return_counts=True)[1] for row in table))
+        denominator = m ** 2 * (items ** 3 - items) - m * ties
+        return 12.0 * spread / denominator if denominator > 0 else 1.0
+
+    w = w_of(ranks)
+    samples = np.array([w_of(ranks[rng.integers(0, raters, raters)]) for _ in range(resamples)])
+    statistic = raters * (items - 1) * w
+    return {"w": w, "ci": [float(np.quantile(samples, 0.025)), float(np.quantile(samples, 0.975))],
+            "chi2": float(statistic), "df": items - 1, "p": float(chi2.sf(statistic, items - 1))}

@@ -25,8 +25,10 @@ AXES = ("questions", "turns", "demonstrations", "seconds")
 SUITE_FIELDS = ("name", "description", "analysis", "kind", "task", "kitchen", "strategies", "datasets", "seeds",
                 "checkpoints", "axis", "costs", "teacher", "options", "dataset", "data_seed", "condition", "finding",
                 "objects_per_scene", "state_schedule")
-# a suite that extends another (issue 39's pre-registered run): the other's suite with more strategies and findings
-EXTENSION_FIELDS = ("extends", "name", "description", "analysis", "add_strategies", "finding")
+# a suite that extends another (issue 39's pre-registered run): the other's suite with more strategies and findings,
+# and (issue 52's studies across kitchens) in another kitchen, with only some of its conditions
+EXTENSION_FIELDS = ("extends", "name", "description", "analysis", "add_strategies", "finding", "kitchen",
+                    "only_conditions")
 CONDITION_FIELDS = ("name", "budget", "turns", "change_every")
 # seconds: embodied costs' time allocation (turns is then the cap); objects_per_scene: the scene size (thesis §6.5)
 # teacher: the scripted teacher's options for this condition, over the suite's [teacher] (a sweep of them)
@@ -189,8 +191,9 @@ def load_suite(name_or_path: str | Path, known_strategies=None) -> Suite:
 
 def _extended(table: dict, where: str) -> dict:
     """``extends = "NAME"``: suite NAME's table with this file's name, description and analysis, its strategies
-    followed by ``add_strategies`` and its findings by this file's; nothing else can change (the same
-    conditions, data, costs and checkpoints), so the extension's episodes are the base suite's."""
+    followed by ``add_strategies`` and its findings by this file's. It may name another ``kitchen`` (a name or a
+    kitchen file's path) and keep ``only_conditions`` (with the base's findings on them); nothing else can change
+    (the same conditions, data, costs and checkpoints), so in the base's kitchen its episodes are the base's."""
     check_keys(table, where, required=("extends", "name"), optional=EXTENSION_FIELDS)
     base_name = text(table, "extends", where)
     if base_name not in suite_names():
@@ -203,9 +206,21 @@ def _extended(table: dict, where: str) -> dict:
     repeated = [s for s in added if s in base.get("strategies", [])]
     if repeated:
         raise SuiteError(f"{where}: add_strategies repeats {repeated}, already in suite '{base_name}'")
-    merged = {**base, **{k: table[k] for k in ("name", "description", "analysis") if k in table}}
+    merged = {**base, **{k: table[k] for k in ("name", "description", "analysis", "kitchen") if k in table}}
     merged["strategies"] = [*base.get("strategies", []), *added]
     merged["finding"] = [*base.get("finding", []), *table.get("finding", [])]
+    if "only_conditions" in table:
+        kept = texts(table, "only_conditions", where, nonempty=True)
+        names = [c.get("name") for c in base.get("condition", [])]
+        unknown = [name for name in kept if name not in names]
+        if unknown:
+            raise SuiteError(f"{where}: only_conditions names {unknown}, not conditions of suite '{base_name}'; "
+                             f"its conditions: {', '.join(map(str, names))}")
+        merged["condition"] = [c for c in base.get("condition", []) if c.get("name") in kept]
+        merged["finding"] = [f for f in merged["finding"] if f.get("condition") in kept]
+        if merged.get("axis") != "seconds":  # the checkpoints the kept conditions reach (they only read curves)
+            longest = max((c.get("turns", 0) for c in merged["condition"]), default=0)
+            merged["checkpoints"] = [c for c in base.get("checkpoints", []) if not isinstance(c, int) or c <= longest]
     return merged
 
 
