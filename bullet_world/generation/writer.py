@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from bullet_world.datafiles import DataFileError
+from bullet_world.datafiles import DataFileError, cache_dir
 from bullet_world.generation.distributions import Distributions, load_distributions
 from bullet_world.generation.layout import Layout, draw_family, draw_layout, location_problem
 from bullet_world.generation.rooms import draw_furniture, draw_materials
@@ -163,3 +163,17 @@ def generate_kitchens(seed: int, count: int, folder: str | Path, distributions_p
         os.replace(draft, path)
         written.append(path)
     return written
+
+
+def cached_kitchens(first: int, last: int, distributions_path: str | Path | None = None) -> list[str]:
+    """The kitchens of seeds ``first`` .. ``last`` as files in the cache (``<cache>/kitchens/<distributions
+    sha256[:12]>/``), written once: what a suite's ``kitchens = { generated = [FIRST, LAST] }`` names."""
+    distributions = load_distributions(distributions_path)
+    folder = cache_dir() / "kitchens" / distributions.sha256[:12]
+    paths = []
+    for seed in range(first, last + 1):
+        path = folder / f"generated-{seed}.toml"
+        if not path.exists():
+            generate_kitchens(seed, 1, folder, distributions.path)
+        paths.append(str(path))
+    return paths

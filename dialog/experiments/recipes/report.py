@@ -22,6 +22,7 @@ from dialog.experiments.recipes.figures import (
     plot_transfer,
     pyplot,
 )
+from dialog.experiments.recipes import kitchen_pairs
 from dialog.experiments.recipes.study import varied_thirds
 from dialog.experiments.recipes.suite import RecipeStudy, run_mean
 from dialog.experiments.report import _fmt_p, skipped_findings_lines
@@ -114,7 +115,8 @@ def plot_overview(summaries: list[CheckpointSummary], recipe: str, path: Path) -
     figure, axis = plt.subplots(figsize=(7.5, 4.2))
     styles = {"cross-validation": ("-", "o", "tab:blue"), "most-varied": ("", "^", "tab:green"),
               "least-varied": ("", "v", "tab:olive"), "situated": ("--", "s", "tab:red"),
-              "elsewhere": ("--", "D", "tab:purple"), "execution": ("", "*", "black")}
+              "elsewhere": ("--", "D", "tab:purple"), "execution": ("", "*", "black"),
+              "kitchen-pairs": (":", "P", "tab:brown")}
     for summary in (s for s in summaries if s.condition == recipe):
         line, marker, colour = styles[summary.strategy]
         axis.errorbar(summary.checkpoints, summary.mean, yerr=summary.error, linestyle=line or "none", marker=marker,
@@ -188,6 +190,8 @@ def write_recipe_report(suite: Suite, study: RecipeStudy, results: dict, summari
         lines += _pairs_section(results, recipe, kinds)
         lines += _transfer_section(results, recipe, study, kinds, out)
         lines += _execution_section(results, recipe)
+        if study.runs("kitchen-pairs"):
+            lines += kitchen_pairs.section(results, recipe, study, out)
     path = out / "report.md"
     path.write_text("\n".join(lines) + "\n", encoding="utf-8")
     return path

@@ -26,6 +26,7 @@ import numpy as np
 from bullet_world.catalogue import load_kitchen
 from bullet_world.recipes.world import RecipeWorld
 from dialog.experiments.analysis import CheckpointSummary, FindingResult
+from dialog.experiments.recipes import kitchen_pairs
 from dialog.experiments.recipes import study as science
 from dialog.experiments.runner import _progress
 from dialog.experiments.suite import Suite, SuiteError
@@ -35,12 +36,16 @@ from learning.recipes.format import load_builtin_recipe
 from learning.significance import mann_whitney, mean_and_standard_error
 from robot.grasping import GRASP_MODES
 
-ARMS = ("cross-validation", "most-varied", "least-varied", "situated", "elsewhere", "execution")
+ARMS = ("cross-validation", "most-varied", "least-varied", "situated", "elsewhere", "execution", "kitchen-pairs")
 OPTIONS = ("recipes", "kitchens", "demos", "cv_repeats", "transfer_demos", "transfer_m", "transfer_repeats",
-           "execution_trials", "grasp", "tau")
+           "execution_trials", "grasp", "tau", "tested_in", "pairs_of_kitchens", "pair_executions")
 DEFAULTS = {"recipes": ["serve-pasta", "serve-salad"], "kitchens": ["kitchen-1", "kitchen-2", "kitchen-3"],
             "demos": 12, "cv_repeats": 12, "transfer_demos": 6, "transfer_m": [2, 5], "transfer_repeats": 10,
-            "execution_trials": 0, "grasp": "friction", "tau": 3.0}
+            "execution_trials": 0, "grasp": "friction", "tau": 3.0, "tested_in": 5, "pairs_of_kitchens": 0,
+            "pair_executions": 0}
+COUNTS = ("demos", "cv_repeats", "transfer_demos", "transfer_repeats", "execution_trials", "tested_in",
+          "pairs_of_kitchens", "pair_executions")
+MAY_BE_ZERO = ("execution_trials", "pairs_of_kitchens", "pair_executions")
 
 
 @dataclass(frozen=True)
@@ -60,11 +65,14 @@ class RecipeStudy:
     execution_trials: int
     grasp: str
     tau: float
+    tested_in: int = 5            # the kitchen-pairs arm (kitchen_pairs.py): test kitchens per training set,
+    pairs_of_kitchens: int = 0    # seeded pairs of training kitchens,
+    pair_executions: int = 0      # and single ordered pairs carried out with the arm
 
     def checkpoints(self, arm: str) -> tuple[int, ...]:
         """The values of m at which ``arm`` is measured."""
         return {"cross-validation": self.cv_m, "most-varied": (2,), "least-varied": (2,), "situated": self.transfer_m,
-                "elsewhere": self.transfer_m, "execution": (self.demos,)}[arm]
+                "elsewhere": self.transfer_m, "execution": (self.demos,), "kitchen-pairs": self.transfer_m}[arm]
 
     def runs(self, *arms: str) -> bool:
         return any(arm in self.arms for arm in arms)
@@ -73,7 +81,7 @@ class RecipeStudy:
     def collected(self) -> int:
         """Demonstrations per recipe and kitchen: the transfer uses the first ``transfer_demos`` of them."""
         within = self.demos if self.runs("cross-validation", "most-varied", "least-varied", "execution") else 0
-        return max(within, self.transfer_demos if self.runs("situated", "elsewhere") else 0)
+        return max(within, self.transfer_demos if self.runs("situated", "elsewhere", "kitchen-pairs") else 0)
 
 
 def load_study(suite: Suite) -> RecipeStudy:
@@ -87,15 +95,15 @@ def load_study(suite: Suite) -> RecipeStudy:
         raise SuiteError(f"{where}: unknown arms {bad_arms} in 'strategies'; a recipes suite accepts: "
                          f"{', '.join(ARMS)}")
     options = {**DEFAULTS, **suite.options}
-    counts = {key: _whole(options, key, where) for key in
-              ("demos", "cv_repeats", "transfer_demos", "transfer_repeats", "execution_trials")}
-    lists = {key: _names(options, key, where) for key in ("recipes", "kitchens")}
+    counts = {key: _whole(options, key, where) for key in COUNTS}
+    lists = {"recipes": _names(options, "recipes", where), "kitchens": _kitchens(options, where)}
     study = RecipeStudy(
         arms=tuple(suite.strategies), recipes=lists["recipes"], kitchens=lists["kitchens"], seeds=tuple(suite.seeds),
         demos=counts["demos"], cv_m=_ms(suite.checkpoints, "checkpoints", where), cv_repeats=counts["cv_repeats"],
         transfer_demos=counts["transfer_demos"], transfer_m=_ms(options["transfer_m"], "transfer_m", where),
         transfer_repeats=counts["transfer_repeats"], execution_trials=counts["execution_trials"],
-        grasp=str(options["grasp"]), tau=float(options["tau"]))
+        grasp=str(options["grasp"]), tau=float(options["tau"]), tested_in=counts["tested_in"],
+        pairs_of_kitchens=counts["pairs_of_kitchens"], pair_executions=counts["pair_executions"])
     _check_values(study, where)
     _check_findings(suite, study, where)
     return study
@@ -103,8 +111,8 @@ def load_study(suite: Suite) -> RecipeStudy:
 
 def _whole(options: dict, key: str, where: str) -> int:
     value = options[key]
-    if not isinstance(value, int) or isinstance(value, bool) or value < (0 if key == "execution_trials" else 1):
-        least = 0 if key == "execution_trials" else 1
+    least = 0 if key in MAY_BE_ZERO else 1
+    if not isinstance(value, int) or isinstance(value, bool) or value < least:
         raise SuiteError(f"{where} [options]: '{key}' must be a whole number >= {least}, got {value!r}")
     return value
 
@@ -114,6 +122,24 @@ def _names(options: dict, key: str, where: str) -> tuple[str, ...]:
     if not isinstance(value, list) or not value or not all(isinstance(v, str) for v in value):
         raise SuiteError(f"{where} [options]: '{key}' must be a non-empty list of names, got {value!r}")
     return tuple(value)
+
+
+def _kitchens(options: dict, where: str) -> tuple[str, ...]:
+    """A list of kitchen names or paths, or ``{ generated = [FIRST, LAST], also = [...] }``: the generator's
+    kitchens of those seeds (written once to the cache, ``bullet_world.generation.cached_kitchens``) and more."""
+    value = options["kitchens"]
+    if not isinstance(value, dict):
+        return _names(options, "kitchens", where)
+    unknown = sorted(set(value) - {"generated", "also"})
+    seeds = value.get("generated")
+    if unknown or not (isinstance(seeds, list) and len(seeds) == 2 and all(
+            isinstance(s, int) and not isinstance(s, bool) and s >= 0 for s in seeds) and seeds[0] <= seeds[1]):
+        raise SuiteError(f"{where} [options]: 'kitchens' as a table must be {{ generated = [FIRST, LAST] }} (seeds "
+                         f"FIRST <= LAST, whole numbers >= 0), optionally with also = [names], got {value!r}")
+    also = _names({"also": value["also"]}, "also", where) if "also" in value else ()
+    from bullet_world.generation import cached_kitchens
+
+    return (*cached_kitchens(seeds[0], seeds[1]), *also)
 
 
 def _ms(values, key: str, where: str) -> tuple[int, ...]:
@@ -183,6 +209,9 @@ def run_job(job: dict) -> dict:
                     recipe, world, demos[:job["execution_m"]], job["trials"], job_rng(seed, recipe.name,
                     job["kitchen"], "execution"), job["grasp"], job["tau"]) if job["trials"] else []
             return {**job, "demos": demos, "runs": executions}
+        if kind in ("kitchen-pairs", "pair-execution"):
+            run = kitchen_pairs.run_trials if kind == "kitchen-pairs" else kitchen_pairs.run_execution
+            return {**{k: v for k, v in job.items() if k != "demos"}, "runs": run(job, recipe, science, job_rng)}
         if kind == "cv":
             runs = science.cross_validation_runs(recipe, job["demos"], job["m"], job["repeats"],
                                                  job_rng(seed, recipe.name, job["kitchen"], "cv"))
@@ -238,11 +267,15 @@ def run_recipe_suite(study: RecipeStudy, workers: int | None = None, progress: b
             every = {k: demos[(seed, recipe, k)][:study.transfer_demos] for k in study.kitchens}
             jobs += [{"kind": "transfer", "seed": seed, "recipe": recipe, "kitchen": kitchen, "demos": every, "m": m,
                       "repeats": study.transfer_repeats} for m in study.transfer_m]
+        if study.runs("kitchen-pairs") and kitchen == study.kitchens[0]:  # one set of jobs a recipe and seed
+            every = {k: demos[(seed, recipe, k)] for k in study.kitchens}
+            jobs += kitchen_pairs.jobs(study, seed, recipe, every, job_rng)
     jobs.sort(key=lambda job: -_cost(job))  # longest first: the pool ends together
     with _progress(len(jobs), progress, "trials") as advance:
         done = _run_all(jobs, min(workers, max(1, len(jobs))), advance)
     grouped: dict[str, list[dict]] = {"collect": [{k: v for k, v in c.items() if k != "demos"} for c in collected],
-                                      "cv": [], "pairs": [], "transfer": []}
+                                      "cv": [], "pairs": [], "transfer": [], "kitchen-pairs": [],
+                                      "pair-execution": []}
     for result in sorted(done, key=lambda r: (r["seed"], r["recipe"], r["kitchen"], r.get("m") if r["kind"] ==
                                               "transfer" else 0)):
         grouped[result["kind"]].append(result)
@@ -250,6 +283,10 @@ def run_recipe_suite(study: RecipeStudy, workers: int | None = None, progress: b
 
 
 def _cost(job: dict) -> float:
+    if job["kind"] == "pair-execution":
+        return 400.0
+    if job["kind"] == "kitchen-pairs":
+        return sum(job["m"]) * len(job["train"]) * len(job["tests"])
     if job["kind"] == "transfer":
         return job["m"] * job["repeats"] * 3
     if job["kind"] == "cv":
@@ -259,7 +296,8 @@ def _cost(job: dict) -> float:
 
 def trial_count(results: dict) -> int:
     """Groundings trained and tested, plus recipes carried out with the arm."""
-    return sum(len(r["runs"]) for kind in ("collect", "cv", "pairs", "transfer") for r in results[kind])
+    return sum(len(r["runs"]) for kind in ("collect", "cv", "pairs", "transfer", "kitchen-pairs", "pair-execution")
+               for r in results.get(kind, ()))
 
 
 # ------------------------------------------------------------------------------------ summaries, findings
@@ -286,6 +324,10 @@ def summarise_study(results: dict, study: RecipeStudy) -> list[CheckpointSummary
                 arm = "situated" if run["situated"] else "elsewhere"
                 key = (result["seed"], run["test"], tuple(run["train"]), run["repeat"])
                 per_arm[arm][key][run["m"]] = run_mean(run)
+        for result in (r for r in results.get("kitchen-pairs", ()) if r["recipe"] == recipe):
+            for run in result["runs"]:
+                key = (result["seed"], tuple(run["train"]), run["test"])
+                per_arm["kitchen-pairs"][key][run["m"]] = run_mean(run)
         for result in (r for r in results["collect"] if r["recipe"] == recipe):
             for run in result["runs"]:
                 per_arm["execution"][(result["seed"], result["kitchen"], run["trial"])][run["m"]] = \
