@@ -7,7 +7,7 @@ suite: dialog/experiments/recipes/kitchen_pairs.py) and whether the most distant
 scores no better than the elsewhere arm's 95 % interval (the thesis's finding reproduced).
 
     .venv/bin/python scripts/kitchen_transfer.py run        # both suites (about an hour on 2 cores)
-    .venv/bin/python scripts/kitchen_transfer.py analyse [--json]   # transfer.md and transfer.json
+    .venv/bin/python scripts/kitchen_transfer.py analyse [--json]   # transfer.md, transfer.json, transfer-*.png
 """
 
 from __future__ import annotations
@@ -26,6 +26,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from dialog.experiments.provenance import git_commit  # noqa: E402
+from dialog.experiments.recipes.kitchen_pairs import plot  # noqa: E402
 
 PLAN = ROOT / "docs" / "kitchen-transfer-plan.toml"
 BOOTSTRAP = 2_000  # the plan's [criterion] bootstrap
@@ -64,6 +65,7 @@ def analyse(out: Path) -> dict:
         recipe = data["recipe"]
         reference = elsewhere_interval(out / "reference" / "runs.csv", recipe, rng)
         at_m = next(a for a in data["analyses"] if a["m"] == M)
+        plot(data, out / f"transfer-{recipe}.png", reference)
         executed = data["executions"]
         summary["recipes"].append({
             "recipe": recipe, "analyses": data["analyses"], "paired": data["paired"], "elsewhere": reference,

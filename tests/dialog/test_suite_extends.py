@@ -55,3 +55,22 @@ def test_the_preregistered_suites_extend_their_thesis_suite(name):
     extended, base = load_suite(name), load_suite(name.removeprefix("prereg-"))
     assert extended.conditions == base.conditions and "dt-voi" in extended.strategies
     assert {f.id for f in base.findings} <= {f.id for f in extended.findings}
+
+
+def test_an_extension_may_move_to_another_kitchen_and_keep_only_some_conditions(tmp_path):
+    """Issue 52's rankings across kitchens: the base's episodes in another kitchen, one condition, its findings,
+    and only the checkpoints that condition reaches."""
+    path = write(tmp_path, 'extends = "ch7"\nname = "ch7-elsewhere"\nkitchen = "kitchen-2"\n'
+                           'only_conditions = ["both-constrained"]\nadd_strategies = ["dt-voi"]\n')
+    base, moved = load_suite("ch7"), load_suite(path, STRATEGY_NAMES)
+    assert moved.kitchen == "kitchen-2" and base.kitchen == "kitchen-1"
+    assert moved.conditions == tuple(c for c in base.conditions if c.name == "both-constrained")
+    assert [f.id for f in moved.findings] == [f.id for f in base.findings if f.condition == "both-constrained"]
+    assert moved.checkpoints == (10, 20, 30, 40) and moved.strategies == (*base.strategies, "dt-voi")
+
+
+def test_only_conditions_names_the_base_suites_conditions(tmp_path):
+    path = write(tmp_path, 'extends = "ch7"\nname = "x"\nonly_conditions = ["both-constrainted"]\n')
+    with pytest.raises(SuiteError, match=r"only_conditions names \['both-constrainted'\], not conditions of suite "
+                                         r"'ch7'; its conditions: time-constrained, unconstrained"):
+        load_suite(path, STRATEGY_NAMES)

@@ -19,6 +19,7 @@ bootstrap band over training kitchens.
 
 from __future__ import annotations
 
+import warnings
 from functools import lru_cache
 
 import numpy as np
@@ -148,7 +149,9 @@ def analyse(rows: list[dict], m: int, permutations: int, bootstrap: int, rng: np
     for _ in range(bootstrap):
         pick = rng.integers(0, len(trainers), len(trainers))
         resampled.append(curve(d[pick], match[pick]))
-    low, high = np.nanquantile(np.array(resampled), [0.025, 0.975], axis=0)
+    with warnings.catch_warnings():  # a quintile no resample reaches (a few pairs only) stays NaN
+        warnings.simplefilter("ignore", RuntimeWarning)
+        low, high = np.nanquantile(np.array(resampled), [0.025, 0.975], axis=0)
     return {"m": m, "pairs": int(match.size), "training_kitchens": len(trainers), "rho": rho, "p": p,
             "falls": bool(rho < 0 and p < alpha), "edges": bands.tolist(), "means": means.tolist(),
             "low": low.tolist(), "high": high.tolist(),
@@ -208,7 +211,9 @@ def section(results: dict, recipe: str, study, out) -> list[str]:
     return lines + [""]
 
 
-def plot(data: dict, path) -> None:
+def plot(data: dict, path, elsewhere: dict | None = None) -> None:
+    """Match against distance per ordered pair, the quintile curve with its band, the executed pairs, and (when
+    given) the recipes suite's elsewhere arm in the shipped three as a grey band."""
     from dialog.experiments.recipes.figures import pyplot
 
     plt = pyplot()
@@ -217,8 +222,11 @@ def plot(data: dict, path) -> None:
         singles = [r for r in data["rows"] if r["m"] == a["m"] and len(r["train"]) == 1]
         axis.scatter([r["distance"] for r in singles], [r["match"] for r in singles], s=8, alpha=0.35, color=colour)
         axis.plot(a["centres"], a["means"], "-o", color=colour, label=f"m = {a['m']}: rho {a['rho']:.2f}, "
-                                                                      f"p {a['p']:.3f}")
+                                                                      f"p {a['p']:.4f}")
         axis.fill_between(a["centres"], a["low"], a["high"], color=colour, alpha=0.2)
+    if elsewhere is not None:
+        axis.axhspan(*elsewhere["ci"], color="grey", alpha=0.3,
+                     label=f"elsewhere arm, shipped kitchens (m = 5): {elsewhere['mean']:.3f}")
     executed = data["executions"]
     if executed:
         axis.scatter([e["distance"] for e in executed], [1.03 if e["success"] else -0.03 for e in executed],
