@@ -5,7 +5,8 @@ file a kitchen and run (``extends`` the run's suite with ``kitchen`` and ``only_
 strategies), kitchen-1 again beside them, every one on the plan's data seeds (``regress --data-seeds``); then
 per kitchen each strategy's rank by its pooled mean score and the agreement across the generated kitchens:
 Kendall's W (tie-corrected) with a bootstrap interval over kitchens and Friedman's test
-(``learning.significance.kendalls_w``). Steps, each resumable (a finished run's replication.json is kept):
+(``dialog.experiments.kitchens.rank_agreement``, as ``regress`` does for a suite that names ``kitchens``).
+Steps, each resumable (a finished run's replication.json is kept):
 
     .venv/bin/python scripts/kitchen_rankings.py prepare     # kitchens and suite files
     .venv/bin/python scripts/kitchen_rankings.py render      # every data set, two renderers at a time
@@ -31,9 +32,10 @@ sys.path.insert(0, str(ROOT))
 
 from bullet_world.generation import generate_kitchens  # noqa: E402
 from dialog.experiments.doc_tables import markdown_table  # noqa: E402
+from dialog.experiments.kitchens import rank_agreement  # noqa: E402
 from dialog.experiments.provenance import git_commit  # noqa: E402
 from learning.datafiles import check_keys, flag, integer, number, numbers, read_toml, section, tables, text, texts  # noqa: E402,E501
-from learning.significance import kendalls_w, ranks_high_first  # noqa: E402
+from learning.significance import ranks_high_first  # noqa: E402
 
 PLAN = ROOT / "docs" / "kitchen-rankings-plan.toml"
 REFERENCE = "kitchen-1"
@@ -148,10 +150,11 @@ def analyse(plan: dict, out: Path) -> dict:
         at = by_kitchen.pop("_at")
         strategies = list(run_plan["strategies"])
         generated = [k for k in by_kitchen if k != REFERENCE]
-        means = np.array([[by_kitchen[k][s] for s in strategies] for k in generated])
-        ranks = np.array([ranks_high_first(row) for row in means])
-        agreement = kendalls_w(ranks, rng, resamples=plan["bootstrap"])
-        reference = ranks_high_first([by_kitchen[REFERENCE][s] for s in strategies]) if REFERENCE in by_kitchen else None
+        agreement = rank_agreement({k: by_kitchen[k] for k in generated}, strategies, rng, plan["bootstrap"])
+        means, ranks = np.array(agreement.pop("means")), np.array(agreement.pop("ranks"))
+        del agreement["kitchens"], agreement["strategies"]
+        reference = (ranks_high_first([by_kitchen[REFERENCE][s] for s in strategies]) if REFERENCE in by_kitchen
+                     else None)
         rows = []
         for j, strategy in enumerate(strategies):
             row = {"strategy": strategy, "ranks": ranks[:, j].tolist(), "means": means[:, j].tolist(),

@@ -127,6 +127,8 @@ def run(args: argparse.Namespace) -> int:
                                 "--embodied-costs without --check")
     out = args.results or inside(Path("results"), Path("results") / suite.name, "results folder")
     check_writable(out, "results", folder=True)
+    if suite.kitchens:
+        return run_across_kitchens(args, kind, suite, original, out)
     if args.data_seeds is not None:
         return run_on_data_seeds(args, kind, suite, original, out)
     with writing(out, "results", inside=True), sweep_progress(args, kind, suite, out, 1) as sweep:
@@ -197,6 +199,54 @@ def shared_pool(args: argparse.Namespace) -> Iterator:
         return
     with EpisodePool(workers) as pool:
         yield pool
+
+
+def run_across_kitchens(args: argparse.Namespace, kind, suite, original, out: Path) -> int:
+    """A suite that names ``kitchens``: one run in each (``<out>/kitchen-NAME/``, on every --data-seeds seed
+    too), then the strategies' ranks per kitchen and Kendall's W across them (``kitchens.md``)."""
+    import json
+    from dataclasses import replace
+
+    import numpy as np
+
+    from dialog.experiments.kitchens import label, rank_agreement, write_rankings
+
+    for refused in ("check", "update_baseline"):
+        if getattr(args, refused):
+            raise SettingsError(f"suite '{suite.name}' runs in {len(suite.kitchens)} kitchens; "
+                                f"--{refused.replace('_', '-')} compares or stores one run: run one kitchen's suite")
+    means: dict[str, dict[str, dict[str, float]]] = {}  # condition -> kitchen -> strategy -> mean
+    for kitchen in suite.kitchens:
+        here, folder = replace(suite, kitchen=kitchen, kitchens=()), out / f"kitchen-{label(kitchen)}"
+        print(f"{suite.name} in {label(kitchen)}", flush=True)
+        if args.data_seeds is not None:
+            run_on_data_seeds(args, kind, here, original, folder)
+            pooled = json.loads((folder / "replication.json").read_text(encoding="utf-8"))["conditions"]
+            for condition in pooled:
+                for row in condition["strategies"]:
+                    means.setdefault(condition["name"], {}).setdefault(kitchen, {})[row["strategy"]] = \
+                        row["pooled"]["mean"]
+            continue
+        with writing(folder, "results", inside=True):
+            folder.mkdir(parents=True, exist_ok=True)
+            outcome = run_suite(kind, here, RunOptions(results=folder, workers=args.workers, ray=args.ray,
+                                                       progress=shows_bars(args)), original)
+            kind.report(outcome, folder)
+        for summary in outcome.summaries:
+            means.setdefault(summary.condition, {}).setdefault(kitchen, {})[summary.strategy] = float(summary.mean[-1])
+    rng = np.random.default_rng(0)
+    rankings = {condition: rank_agreement(by_kitchen, suite.strategies, rng) for condition, by_kitchen in means.items()}
+    words = ["regress", "--suite", args.suite] + (["--data-seeds", *args.data_seeds] if args.data_seeds else [])
+    with writing(out, "results", inside=True):
+        path = write_rankings(suite.name, rankings, out, command_line(words))
+    print(f"across {len(suite.kitchens)} kitchens: {path}")
+    for condition, result in rankings.items():
+        if "w" in result:
+            print(f"  {condition}: Kendall's W {result['w']:.3f} [{result['ci'][0]:.3f}, {result['ci'][1]:.3f}]")
+    if args.json:
+        print_json({"suite": suite.name, "kitchens": [label(k) for k in suite.kitchens],
+                    "kendalls_w": {c: r.get("w") for c, r in rankings.items()}})
+    return 0
 
 
 def run_on_data_seeds(args: argparse.Namespace, kind, suite, original, out: Path) -> int:

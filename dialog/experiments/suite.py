@@ -24,11 +24,11 @@ KINDS = ("episodes", "feature-selection", "recipes")
 AXES = ("questions", "turns", "demonstrations", "seconds")
 SUITE_FIELDS = ("name", "description", "analysis", "kind", "task", "kitchen", "strategies", "datasets", "seeds",
                 "checkpoints", "axis", "costs", "teacher", "options", "dataset", "data_seed", "condition", "finding",
-                "objects_per_scene", "state_schedule")
+                "objects_per_scene", "state_schedule", "kitchens")
 # a suite that extends another (issue 39's pre-registered run): the other's suite with more strategies and findings,
 # and (issue 52's studies across kitchens) in another kitchen, with only some of its conditions
 EXTENSION_FIELDS = ("extends", "name", "description", "analysis", "add_strategies", "finding", "kitchen",
-                    "only_conditions")
+                    "kitchens", "only_conditions")
 CONDITION_FIELDS = ("name", "budget", "turns", "change_every")
 # seconds: embodied costs' time allocation (turns is then the cap); objects_per_scene: the scene size (thesis §6.5)
 # teacher: the scripted teacher's options for this condition, over the suite's [teacher] (a sweep of them)
@@ -105,6 +105,7 @@ class Suite:
     analysis: str = ""  # where the written analysis of the findings lives (shown in the report)
     data_seed: int = 0  # the seed the data sets are rendered from (0: the data of every stored baseline)
     weights: dict = field(default_factory=dict)  # strategy name -> user's DT weights (regress --weights NAME=FILE)
+    kitchens: tuple[str, ...] = ()  # an episodes suite run in each of these (dialog/experiments/kitchens.py)
 
     @property
     def plan_options(self) -> tuple:
@@ -206,7 +207,10 @@ def _extended(table: dict, where: str) -> dict:
     repeated = [s for s in added if s in base.get("strategies", [])]
     if repeated:
         raise SuiteError(f"{where}: add_strategies repeats {repeated}, already in suite '{base_name}'")
-    merged = {**base, **{k: table[k] for k in ("name", "description", "analysis", "kitchen") if k in table}}
+    merged = {**base, **{k: table[k] for k in ("name", "description", "analysis", "kitchen", "kitchens")
+                         if k in table}}
+    if "kitchens" in table:
+        merged.pop("kitchen", None)
     merged["strategies"] = [*base.get("strategies", []), *added]
     merged["finding"] = [*base.get("finding", []), *table.get("finding", [])]
     if "only_conditions" in table:
@@ -260,18 +264,34 @@ def _suite(table: dict, where: str, known_strategies) -> Suite:
     _check_seeds(seeds, f"{where}: seeds", SuiteError)
     checkpoints = numbers(table, "checkpoints", where, whole=True, low=0)
     _check_checkpoints(checkpoints, kind, table.get("axis", "questions"), conditions, where)
+    kitchens = _kitchens(table, kind, where)
     return Suite(
         name=datafiles.name(table, "name", where, what="suite name"),
         description=text(table, "description", where, "", nonempty=False),
-        kind=kind, task=text(table, "task", where, "pack-lunchbox"), kitchen=text(table, "kitchen", where, "kitchen-1"),
+        kind=kind, task=text(table, "task", where, "pack-lunchbox"),
+        kitchen=kitchens[0] if kitchens else text(table, "kitchen", where, "kitchen-1"),
         strategies=strategies, conditions=conditions,
         datasets=integer(table, "datasets", where, 5, low=1, high=maximum("datasets")),
         seeds=seeds, checkpoints=checkpoints,
         axis=text(table, "axis", where, "questions", choices=AXES), costs=costs,
         teacher=_teacher(table, where), findings=findings, options=_options(table, kind, where), path=where,
         dataset=_plan(table, where), analysis=text(table, "analysis", where, "", nonempty=False),
-        data_seed=integer(table, "data_seed", where, 0, low=0),
+        data_seed=integer(table, "data_seed", where, 0, low=0), kitchens=kitchens,
     )
+
+
+def _kitchens(table: dict, kind: str, where: str) -> tuple[str, ...]:
+    """An episodes suite's ``kitchens`` (``dialog.experiments.kitchens.kitchen_list``), or none."""
+    if "kitchens" not in table:
+        return ()
+    if kind != "episodes":
+        raise SuiteError(f"{where}: 'kitchens' runs an episodes suite in each kitchen; a suite of kind '{kind}' "
+                         "names one 'kitchen' (a recipes suite lists its kitchens under [options])")
+    if "kitchen" in table:
+        raise SuiteError(f"{where}: give 'kitchen' (one) or 'kitchens' (a run in each), not both")
+    from dialog.experiments.kitchens import kitchen_list
+
+    return kitchen_list(table["kitchens"], where)
 
 
 def _condition(table: dict, where: str, objects_per_scene: int | None = None,

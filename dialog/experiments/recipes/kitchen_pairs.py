@@ -20,19 +20,20 @@ bootstrap band over training kitchens.
 from __future__ import annotations
 
 import warnings
-from functools import lru_cache
+from functools import cache
 
 import numpy as np
 from scipy.stats import spearmanr
 
 from bullet_world.recipes.distance import kitchen_distance
+from dialog.experiments.kitchens import label
 from dialog.recipe_session import recipe_steps
 from learning.recipes.format import load_builtin_recipe
 
 QUANTILES = 5
 
 
-@lru_cache(maxsize=None)
+@cache
 def distance(recipe: str, first: str, second: str) -> float:
     return kitchen_distance(recipe_steps(load_builtin_recipe(recipe)), recipe, first, second).total
 
@@ -155,15 +156,11 @@ def analyse(rows: list[dict], m: int, permutations: int, bootstrap: int, rng: np
     return {"m": m, "pairs": int(match.size), "training_kitchens": len(trainers), "rho": rho, "p": p,
             "falls": bool(rho < 0 and p < alpha), "edges": bands.tolist(), "means": means.tolist(),
             "low": low.tolist(), "high": high.tolist(),
-            "centres": [float(np.mean(d.ravel()[q == i])) if np.any(q == i) else float("nan") for i in range(QUANTILES)]}
+            "centres": [float(np.mean(d.ravel()[q == i])) if np.any(q == i) else float("nan")
+                        for i in range(QUANTILES)]}
 
 
 PERMUTATIONS, BOOTSTRAP, ALPHA = 10_000, 2_000, 0.05  # fixed by docs/kitchen-transfer-plan.toml [criterion]
-
-
-def label(kitchen: str) -> str:
-    """A kitchen's short name: ``generated-7200`` for a generated file's path, the name for a shipped one."""
-    return kitchen.rsplit("/", 1)[-1].removesuffix(".toml")
 
 
 def summary(results: dict, recipe: str, study) -> dict:

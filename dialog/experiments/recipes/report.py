@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from dialog.experiments.analysis import CheckpointSummary, FindingResult
+from dialog.experiments.recipes import kitchen_pairs
 from dialog.experiments.recipes.figures import (
     markdown_cv,
     markdown_transfer,
@@ -22,7 +23,6 @@ from dialog.experiments.recipes.figures import (
     plot_transfer,
     pyplot,
 )
-from dialog.experiments.recipes import kitchen_pairs
 from dialog.experiments.recipes.study import varied_thirds
 from dialog.experiments.recipes.suite import RecipeStudy, run_mean
 from dialog.experiments.report import _fmt_p, skipped_findings_lines

@@ -26,12 +26,14 @@ import numpy as np
 from bullet_world.catalogue import load_kitchen
 from bullet_world.recipes.world import RecipeWorld
 from dialog.experiments.analysis import CheckpointSummary, FindingResult
+from dialog.experiments.kitchens import kitchen_list
 from dialog.experiments.recipes import kitchen_pairs
 from dialog.experiments.recipes import study as science
 from dialog.experiments.runner import _progress
 from dialog.experiments.suite import Suite, SuiteError
 from dialog.recipe_session import recipe_steps
 from dialog.threads import one_blas_thread
+from learning.errors import DataFileError
 from learning.recipes.format import load_builtin_recipe
 from learning.significance import mann_whitney, mean_and_standard_error
 from robot.grasping import GRASP_MODES
@@ -125,21 +127,11 @@ def _names(options: dict, key: str, where: str) -> tuple[str, ...]:
 
 
 def _kitchens(options: dict, where: str) -> tuple[str, ...]:
-    """A list of kitchen names or paths, or ``{ generated = [FIRST, LAST], also = [...] }``: the generator's
-    kitchens of those seeds (written once to the cache, ``bullet_world.generation.cached_kitchens``) and more."""
-    value = options["kitchens"]
-    if not isinstance(value, dict):
-        return _names(options, "kitchens", where)
-    unknown = sorted(set(value) - {"generated", "also"})
-    seeds = value.get("generated")
-    if unknown or not (isinstance(seeds, list) and len(seeds) == 2 and all(
-            isinstance(s, int) and not isinstance(s, bool) and s >= 0 for s in seeds) and seeds[0] <= seeds[1]):
-        raise SuiteError(f"{where} [options]: 'kitchens' as a table must be {{ generated = [FIRST, LAST] }} (seeds "
-                         f"FIRST <= LAST, whole numbers >= 0), optionally with also = [names], got {value!r}")
-    also = _names({"also": value["also"]}, "also", where) if "also" in value else ()
-    from bullet_world.generation import cached_kitchens
-
-    return (*cached_kitchens(seeds[0], seeds[1]), *also)
+    """The suite's kitchens (``dialog.experiments.kitchens.kitchen_list``: names, paths or a generator seed range)."""
+    try:
+        return kitchen_list(options["kitchens"], f"{where} [options]")
+    except DataFileError as error:
+        raise SuiteError(str(error)) from None
 
 
 def _ms(values, key: str, where: str) -> tuple[int, ...]:
