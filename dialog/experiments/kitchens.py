@@ -33,7 +33,7 @@ def kitchen_list(value, where: str, key: str = "kitchens") -> tuple[str, ...]:
         from bullet_world.generation import cached_kitchens
 
         also = kitchen_list_of_names(value.get("also", []), where, f"{key}.also", empty=True)
-        return (*cached_kitchens(seeds[0], seeds[1]), *also)
+        return kitchen_list_of_names([*cached_kitchens(seeds[0], seeds[1]), *also], where, key)
     return kitchen_list_of_names(value, where, key)
 
 
@@ -41,8 +41,11 @@ def kitchen_list_of_names(value, where: str, key: str, empty: bool = False) -> t
     if not isinstance(value, list) or (not value and not empty) or not all(isinstance(v, str) and v for v in value):
         raise DataFileError(f"{where}: '{key}' must be a non-empty list of kitchen names or paths, or "
                             f"{{ generated = [FIRST, LAST] }}, got {value!r}")
-    if len(set(value)) != len(value):
-        raise DataFileError(f"{where}: '{key}' names a kitchen twice: {value!r}")
+    names = [label(v) for v in value]
+    if len(set(names)) != len(names):
+        twice = sorted({n for n in names if names.count(n) > 1})
+        raise DataFileError(f"{where}: '{key}' names a kitchen twice ({', '.join(twice)}; a kitchen file is known by "
+                            f"its name without .toml): {value!r}")
     return tuple(value)
 
 

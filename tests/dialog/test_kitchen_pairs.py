@@ -79,3 +79,20 @@ def test_a_bad_kitchen_range_is_one_clear_line(tmp_path, capsys, kitchens, messa
     assert main(["regress", "--suite", str(suite), "--results", str(tmp_path / "out"), "--no-progress"]) == 2
     error = capsys.readouterr().err.strip()
     assert len(error.splitlines()) == 1 and message in error
+
+
+def test_the_draws_follow_the_kitchens_names_not_where_their_files_are():
+    """A generated kitchen's file sits in the cache, which differs from machine to machine."""
+    from types import SimpleNamespace
+
+    from dialog.experiments.kitchens import label
+    from dialog.experiments.recipes.kitchen_pairs import training_sets
+    from dialog.experiments.recipes.suite import job_rng
+
+    def drawn(folder: str) -> list:
+        kitchens = [f"{folder}/generated-{s}.toml" for s in (1, 2, 3)] + ["kitchen-1", "kitchen-2"]
+        study = SimpleNamespace(kitchens=kitchens, tested_in=2, pairs_of_kitchens=2)
+        return [([label(k) for k in train], [label(k) for k in tests])
+                for train, tests in training_sets(study, 0, job_rng)]
+
+    assert drawn("/root/.cache/teachbot/kitchens/abc") == drawn("zz/elsewhere")

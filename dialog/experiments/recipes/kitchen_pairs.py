@@ -23,7 +23,7 @@ import warnings
 from functools import cache
 
 import numpy as np
-from scipy.stats import spearmanr
+from scipy.stats import ConstantInputWarning, spearmanr
 
 from bullet_world.recipes.distance import kitchen_distance
 from dialog.experiments.kitchens import label
@@ -38,6 +38,12 @@ def distance(recipe: str, first: str, second: str) -> float:
     return kitchen_distance(recipe_steps(load_builtin_recipe(recipe)), recipe, first, second).total
 
 
+def _rng(job_rng, seed: int, *names) -> np.random.Generator:
+    """The suite's per-job generator, kitchens named by their short names (``label``): a generated kitchen's
+    draws do not depend on where the cache put its file."""
+    return job_rng(seed, *(label(str(name)) for name in names))
+
+
 def _draw(rng: np.random.Generator, pool: list[str], count: int) -> list[str]:
     return [pool[i] for i in sorted(rng.choice(len(pool), size=min(count, len(pool)), replace=False).tolist())]
 
@@ -46,19 +52,19 @@ def training_sets(study, seed: int, job_rng) -> list[tuple[tuple[str, ...], list
     """(training kitchens, test kitchens) for every single kitchen and every seeded pair; the same draws for
     every recipe and m, so the arms compare like with like."""
     kitchens = list(study.kitchens)
-    sets = [((k,), _draw(job_rng(seed, "tested-in", k), [o for o in kitchens if o != k], study.tested_in))
+    sets = [((k,), _draw(_rng(job_rng, seed, "tested-in", k), [o for o in kitchens if o != k], study.tested_in))
             for k in kitchens]
     every_pair = [(a, b) for i, a in enumerate(kitchens) for b in kitchens[i + 1:]]
-    chosen = job_rng(seed, "kitchen pairs").choice(len(every_pair), size=min(study.pairs_of_kitchens,
+    chosen = _rng(job_rng, seed, "kitchen pairs").choice(len(every_pair), size=min(study.pairs_of_kitchens,
                                                                                len(every_pair)), replace=False)
     for a, b in (every_pair[i] for i in sorted(chosen.tolist())):
         rest = [o for o in kitchens if o not in (a, b)]
-        sets.append(((a, b), _draw(job_rng(seed, "tested-in", a, b), rest, study.tested_in)))
+        sets.append(((a, b), _draw(_rng(job_rng, seed, "tested-in", a, b), rest, study.tested_in)))
     return sets
 
 
 def chosen_demos(job_rng, seed: int, recipe: str, kitchen: str, m: int, available: int) -> list[int]:
-    return sorted(job_rng(seed, recipe, "kitchen-pairs", kitchen, m).choice(available, size=m,
+    return sorted(_rng(job_rng, seed, recipe, "kitchen-pairs", kitchen, m).choice(available, size=m,
                                                                              replace=False).tolist())
 
 
@@ -73,10 +79,9 @@ def jobs(study, seed: int, recipe: str, demos: dict, job_rng) -> list[dict]:
     m = max(study.transfer_m)
     singles = [(t["train"][0], test) for t in trials if len(t["train"]) == 1 for test in t["tests"]]
     distances = np.array([distance(recipe, a, b) for a, b in singles])
-    quintile = _quintiles(distances)
-    rng, picked = job_rng(seed, recipe, "executions"), []
-    for q in range(QUANTILES):
-        members = np.flatnonzero(quintile == q)
+    rng, picked = _rng(job_rng, seed, recipe, "executions"), []
+    # fifths by rank (ties by order), so that every fifth has members however many distances tie
+    for q, members in enumerate(np.array_split(np.argsort(distances, kind="stable"), QUANTILES)):
         share = study.pair_executions // QUANTILES + (q < study.pair_executions % QUANTILES)
         picked += sorted(rng.choice(members, size=min(share, len(members)), replace=False).tolist())
     executions = []
@@ -96,7 +101,7 @@ def run_trials(job: dict, recipe, science, job_rng) -> list[dict]:
         train = [job["demos"][k][i] for k in job["train"]
                  for i in chosen_demos(job_rng, job["seed"], recipe.name, k, m, len(job["demos"][k]))]
         for test in job["tests"]:
-            rng = job_rng(job["seed"], recipe.name, "kitchen-pairs", *job["train"], test, m)
+            rng = _rng(job_rng, job["seed"], recipe.name, "kitchen-pairs", *job["train"], test, m)
             rows.append({"m": m, "train": list(job["train"]), "test": test,
                          "distance": min(distance(recipe.name, k, test) for k in job["train"]),
                          "accuracy": science.accuracy(recipe, train, job["demos"][test], rng)})
@@ -109,8 +114,8 @@ def run_execution(job: dict, recipe, science, job_rng) -> list[dict]:
 
     with RecipeWorld(recipe_steps(recipe), task=recipe.name, kitchen=job["test"], seed=job["seed"]) as world:
         (run,) = science.execution_runs(recipe, world, job["demos"], 1,
-                                        job_rng(job["seed"], recipe.name, "pair-execution", job["train"][0],
-                                                job["test"]), job["grasp"], job["tau"])
+                                        _rng(job_rng, job["seed"], recipe.name, "pair-execution", job["train"][0],
+                                             job["test"]), job["grasp"], job["tau"])
     return [{**run, "train": list(job["train"]), "test": job["test"], "m": job["m"],
              "distance": distance(recipe.name, job["train"][0], job["test"]),
              "success": all(step["success"] for step in run["steps"])}]
@@ -128,15 +133,17 @@ def analyse(rows: list[dict], m: int, permutations: int, bootstrap: int, rng: np
     them, and the mean match per distance quintile with a 95 % bootstrap band over training kitchens."""
     singles = [r for r in rows if r["m"] == m and len(r["train"]) == 1]
     trainers = sorted({r["train"][0] for r in singles})
-    blocks = {k: [r for r in singles if r["train"][0] == k] for k in trainers}
+    blocks = {k: sorted((r for r in singles if r["train"][0] == k), key=lambda r: r["test"]) for k in trainers}
     size = {len(b) for b in blocks.values()}
     if len(size) != 1:
         raise ValueError(f"every training kitchen needs as many test kitchens, got {sorted(size)}")
     d = np.array([[r["distance"] for r in blocks[k]] for k in trainers])
     match = np.array([[np.mean(list(r["accuracy"].values())) for r in blocks[k]] for k in trainers])
-    rho = float(spearmanr(d.ravel(), match.ravel()).statistic)
-    shuffled = np.array([spearmanr(d.ravel(), match[rng.permutation(len(trainers))].ravel()).statistic
-                         for _ in range(permutations)])
+    with warnings.catch_warnings():  # a constant column (a few pairs only) has no rho: NaN, never "falls"
+        warnings.simplefilter("ignore", ConstantInputWarning)
+        rho = float(spearmanr(d.ravel(), match.ravel()).statistic)
+        shuffled = np.array([spearmanr(d.ravel(), match[rng.permutation(len(trainers))].ravel()).statistic
+                             for _ in range(permutations)])
     p = float((1 + np.sum(shuffled <= rho)) / (1 + permutations))
     edges = np.quantile(d.ravel(), np.linspace(0, 1, QUANTILES + 1)[1:-1])
     bands = np.quantile(d.ravel(), np.linspace(0, 1, QUANTILES + 1))
@@ -165,7 +172,11 @@ PERMUTATIONS, BOOTSTRAP, ALPHA = 10_000, 2_000, 0.05  # fixed by docs/kitchen-tr
 
 def summary(results: dict, recipe: str, study) -> dict:
     """Every row of the arm for ``recipe`` (short kitchen names) and the plan's analysis at each m."""
-    rows = [run for r in results.get("kitchen-pairs", ()) if r["recipe"] == recipe for run in r["runs"]]
+    rows = [{"m": run["m"], "train": [label(k) for k in run["train"]], "test": label(run["test"]),
+             "distance": run["distance"], "match": float(np.mean(list(run["accuracy"].values()))),
+             "accuracy": run["accuracy"]}
+            for r in results.get("kitchen-pairs", ()) if r["recipe"] == recipe for run in r["runs"]]
+    rows.sort(key=lambda r: (r["m"], len(r["train"]), r["train"], r["test"]))  # by name, wherever the files are
     executed = [run for r in results.get("pair-execution", ()) if r["recipe"] == recipe for run in r["runs"]]
     rng = np.random.default_rng(list(map(ord, recipe)))
     analyses = [analyse(rows, m, PERMUTATIONS, BOOTSTRAP, rng, ALPHA) for m in study.transfer_m]
@@ -173,9 +184,7 @@ def summary(results: dict, recipe: str, study) -> dict:
               for m in study.transfer_m}
     return {"recipe": recipe, "analyses": analyses,
             "paired": {str(m): {"trials": len(v), "mean": float(np.mean(v)) if v else None} for m, v in paired.items()},
-            "rows": [{"m": r["m"], "train": [label(k) for k in r["train"]], "test": label(r["test"]),
-                      "distance": r["distance"], "match": float(np.mean(list(r["accuracy"].values()))),
-                      "accuracy": r["accuracy"]} for r in rows],
+            "rows": rows,
             "executions": [{"train": label(r["train"][0]), "test": label(r["test"]), "m": r["m"],
                             "distance": r["distance"], "success": r["success"],
                             "steps": [s["status"] for s in r["steps"]]} for r in executed]}
