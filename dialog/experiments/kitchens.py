@@ -37,6 +37,18 @@ def kitchen_list(value, where: str, key: str = "kitchens") -> tuple[str, ...]:
     return kitchen_list_of_names(value, where, key)
 
 
+def suite_kitchens(table: dict, kind: str, where: str) -> tuple[str, ...]:
+    """An episodes suite's top-level ``kitchens``, or none; a bad one is one ``DataFileError`` line."""
+    if "kitchens" not in table:
+        return ()
+    if kind != "episodes":
+        raise DataFileError(f"{where}: 'kitchens' runs an episodes suite in each kitchen; a suite of kind '{kind}' "
+                            "names one 'kitchen' (a recipes suite lists its kitchens under [options])")
+    if "kitchen" in table:
+        raise DataFileError(f"{where}: give 'kitchen' (one) or 'kitchens' (a run in each), not both")
+    return kitchen_list(table["kitchens"], where)
+
+
 def kitchen_list_of_names(value, where: str, key: str, empty: bool = False) -> tuple[str, ...]:
     if not isinstance(value, list) or (not value and not empty) or not all(isinstance(v, str) and v for v in value):
         raise DataFileError(f"{where}: '{key}' must be a non-empty list of kitchen names or paths, or "

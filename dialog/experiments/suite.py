@@ -10,6 +10,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
+from dialog.experiments.kitchens import suite_kitchens
 from dialog.experiments.registry import kind_names
 from dialog.settings import check_budget_pays_for_a_question
 from learning import datafiles
@@ -264,7 +265,7 @@ def _suite(table: dict, where: str, known_strategies) -> Suite:
     _check_seeds(seeds, f"{where}: seeds", SuiteError)
     checkpoints = numbers(table, "checkpoints", where, whole=True, low=0)
     _check_checkpoints(checkpoints, kind, table.get("axis", "questions"), conditions, where)
-    kitchens = _kitchens(table, kind, where)
+    kitchens = suite_kitchens(table, kind, where)
     return Suite(
         name=datafiles.name(table, "name", where, what="suite name"),
         description=text(table, "description", where, "", nonempty=False),
@@ -278,20 +279,6 @@ def _suite(table: dict, where: str, known_strategies) -> Suite:
         dataset=_plan(table, where), analysis=text(table, "analysis", where, "", nonempty=False),
         data_seed=integer(table, "data_seed", where, 0, low=0), kitchens=kitchens,
     )
-
-
-def _kitchens(table: dict, kind: str, where: str) -> tuple[str, ...]:
-    """An episodes suite's ``kitchens`` (``dialog.experiments.kitchens.kitchen_list``), or none."""
-    if "kitchens" not in table:
-        return ()
-    if kind != "episodes":
-        raise SuiteError(f"{where}: 'kitchens' runs an episodes suite in each kitchen; a suite of kind '{kind}' "
-                         "names one 'kitchen' (a recipes suite lists its kitchens under [options])")
-    if "kitchen" in table:
-        raise SuiteError(f"{where}: give 'kitchen' (one) or 'kitchens' (a run in each), not both")
-    from dialog.experiments.kitchens import kitchen_list
-
-    return kitchen_list(table["kitchens"], where)
 
 
 def _condition(table: dict, where: str, objects_per_scene: int | None = None,
