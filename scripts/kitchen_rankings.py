@@ -32,7 +32,7 @@ sys.path.insert(0, str(ROOT))
 
 from bullet_world.generation import generate_kitchens  # noqa: E402
 from dialog.experiments.doc_tables import markdown_table  # noqa: E402
-from dialog.experiments.kitchens import rank_agreement  # noqa: E402
+from dialog.experiments.kitchens import pooled_means, rank_agreement, read_replication  # noqa: E402
 from dialog.experiments.provenance import git_commit  # noqa: E402
 from learning.datafiles import check_keys, flag, integer, number, numbers, read_toml, section, tables, text, texts  # noqa: E402,E501
 from learning.significance import ranks_high_first  # noqa: E402
@@ -128,10 +128,10 @@ def scores(plan: dict, out: Path) -> dict:
     """{suite: {kitchen label: {strategy: pooled mean score at the condition's last checkpoint}}}."""
     table: dict = {}
     for suite, label, _ in suite_files(plan, out):
-        data = json.loads((out / "runs" / f"{suite}-{label}" / "replication.json").read_text(encoding="utf-8"))
-        (condition,) = data["conditions"]
-        table.setdefault(suite, {})[label] = {row["strategy"]: row["pooled"]["mean"] for row in condition["strategies"]}
-        table[suite].setdefault("_at", {})[label] = [row["at"] for row in condition["strategies"]][0]
+        replication = read_replication(out / "runs" / f"{suite}-{label}")
+        ((condition, by_strategy),) = pooled_means(replication).items()
+        table.setdefault(suite, {})[label] = by_strategy
+        table[suite].setdefault("_at", {})[label] = replication["conditions"][0]["strategies"][0]["at"]
     return table
 
 

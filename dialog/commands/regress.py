@@ -204,12 +204,11 @@ def shared_pool(args: argparse.Namespace) -> Iterator:
 def run_across_kitchens(args: argparse.Namespace, kind, suite, original, out: Path) -> int:
     """A suite that names ``kitchens``: one run in each (``<out>/kitchen-NAME/``, on every --data-seeds seed
     too), then the strategies' ranks per kitchen and Kendall's W across them (``kitchens.md``)."""
-    import json
     from dataclasses import replace
 
     import numpy as np
 
-    from dialog.experiments.kitchens import label, rank_agreement, write_rankings
+    from dialog.experiments.kitchens import label, pooled_means, rank_agreement, read_replication, write_rankings
 
     for refused in ("check", "update_baseline"):
         if getattr(args, refused):
@@ -221,11 +220,8 @@ def run_across_kitchens(args: argparse.Namespace, kind, suite, original, out: Pa
         print(f"{suite.name} in {label(kitchen)}", flush=True)
         if args.data_seeds is not None:
             run_on_data_seeds(args, kind, here, original, folder)
-            pooled = json.loads((folder / "replication.json").read_text(encoding="utf-8"))["conditions"]
-            for condition in pooled:
-                for row in condition["strategies"]:
-                    means.setdefault(condition["name"], {}).setdefault(kitchen, {})[row["strategy"]] = \
-                        row["pooled"]["mean"]
+            for condition, by_strategy in pooled_means(read_replication(folder)).items():
+                means.setdefault(condition, {})[kitchen] = by_strategy
             continue
         with writing(folder, "results", inside=True):
             folder.mkdir(parents=True, exist_ok=True)

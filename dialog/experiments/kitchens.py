@@ -78,6 +78,17 @@ def rank_agreement(means: dict[str, dict[str, float]], strategies, rng: np.rando
             **agreement}
 
 
+def read_replication(folder: Path) -> dict:
+    """A ``regress --data-seeds`` run's ``replication.json``."""
+    return json.loads((folder / "replication.json").read_text(encoding="utf-8"))
+
+
+def pooled_means(replication: dict) -> dict[str, dict[str, float]]:
+    """{condition: {strategy: mean at its last checkpoint, pooled over the data seeds}} of ``read_replication``."""
+    return {c["name"]: {row["strategy"]: row["pooled"]["mean"] for row in c["strategies"]}
+            for c in replication["conditions"]}
+
+
 def write_rankings(suite_name: str, by_condition: dict[str, dict], out: Path, command: str) -> Path:
     """``kitchens.md`` and ``kitchens.json``: per condition the ranks per kitchen and Kendall's W."""
     lines = [f"# `{suite_name}` across kitchens", "", f"Command: `{command}`. Each kitchen's own report is in "

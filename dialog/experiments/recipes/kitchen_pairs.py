@@ -130,7 +130,8 @@ def analyse(rows: list[dict], m: int, permutations: int, bootstrap: int, rng: np
             alpha: float = 0.05) -> dict:
     """The plan's criterion on the single ordered pairs at ``m``: Spearman's rho of distance against mean
     parameter match, its one-sided (less) permutation p with whole training kitchens' scores shuffled among
-    them, and the mean match per distance quintile with a 95 % bootstrap band over training kitchens."""
+    them, and the mean match per distance quintile with a 95 % bootstrap band over training kitchens. ``rows``
+    are ``summary``'s: kitchens by their short names, ``match`` the mean over the recipe's parameters."""
     singles = [r for r in rows if r["m"] == m and len(r["train"]) == 1]
     trainers = sorted({r["train"][0] for r in singles})
     blocks = {k: sorted((r for r in singles if r["train"][0] == k), key=lambda r: r["test"]) for k in trainers}
@@ -138,7 +139,7 @@ def analyse(rows: list[dict], m: int, permutations: int, bootstrap: int, rng: np
     if len(size) != 1:
         raise ValueError(f"every training kitchen needs as many test kitchens, got {sorted(size)}")
     d = np.array([[r["distance"] for r in blocks[k]] for k in trainers])
-    match = np.array([[np.mean(list(r["accuracy"].values())) for r in blocks[k]] for k in trainers])
+    match = np.array([[r["match"] for r in blocks[k]] for k in trainers])
     with warnings.catch_warnings():  # a constant column (a few pairs only) has no rho: NaN, never "falls"
         warnings.simplefilter("ignore", ConstantInputWarning)
         rho = float(spearmanr(d.ravel(), match.ravel()).statistic)
@@ -180,8 +181,7 @@ def summary(results: dict, recipe: str, study) -> dict:
     executed = [run for r in results.get("pair-execution", ()) if r["recipe"] == recipe for run in r["runs"]]
     rng = np.random.default_rng(list(map(ord, recipe)))
     analyses = [analyse(rows, m, PERMUTATIONS, BOOTSTRAP, rng, ALPHA) for m in study.transfer_m]
-    paired = {m: [float(np.mean(list(r["accuracy"].values()))) for r in rows if r["m"] == m and len(r["train"]) == 2]
-              for m in study.transfer_m}
+    paired = {m: [r["match"] for r in rows if r["m"] == m and len(r["train"]) == 2] for m in study.transfer_m}
     return {"recipe": recipe, "analyses": analyses,
             "paired": {str(m): {"trials": len(v), "mean": float(np.mean(v)) if v else None} for m, v in paired.items()},
             "rows": rows,
